@@ -1,0 +1,304 @@
+//! Consistency rules over a loaded spec (see `spec/SCHEMA.md`, "The loader rejects …").
+
+use crate::error::{Problem, ProblemKind};
+use crate::{Family, Parameter, Spec};
+use std::collections::BTreeMap;
+
+/// Every rule violated by the spec, in family and file order.
+pub(crate) fn validate(spec: &Spec) -> Vec<Problem> {
+    let mut problems = Vec::new();
+    for family in spec.families() {
+        let mut v = Validator { family, problems: &mut problems };
+        v.unique_ids();
+        v.parameters();
+        v.addresses();
+        v.models();
+        v.bitfields();
+        v.requirements();
+        v.errata();
+        v.vectors();
+    }
+    problems
+}
+
+struct Validator<'a> {
+    family: &'a Family,
+    problems: &'a mut Vec<Problem>,
+}
+
+impl Validator<'_> {
+    fn push(&mut self, file: &str, record: String, kind: ProblemKind) {
+        self.problems.push(Problem::record(file, record, kind));
+    }
+
+    fn dangling(&mut self, file: &str, record: String, what: &'static str, id: &str) {
+        self.push(file, record, ProblemKind::Dangling { what, id: id.to_owned() });
+    }
+
+    fn check_unique<'k>(&mut self, what: &'static str, items: impl Iterator<Item = (String, &'k str, String)>) {
+        let mut seen: BTreeMap<String, &str> = BTreeMap::new();
+        for (key, file, record) in items {
+            if let Some(first) = seen.get(&key) {
+                let first = (*first).to_owned();
+                self.push(file, record, ProblemKind::Duplicate { what, id: key, first });
+            } else {
+                seen.insert(key, file);
+            }
+        }
+    }
+
+    fn unique_ids(&mut self) {
+        let f = self.family;
+        self.check_unique("parameter id", f.parameters.iter().map(|p| (p.id.to_lowercase(), p.file.as_str(), rec_p(p))));
+        self.check_unique(
+            "parameter number",
+            f.parameters.iter().map(|p| {
+                let key = match p.subindex {
+                    Some(s) => format!("{}.{s}", p.number),
+                    None => p.number.to_string(),
+                };
+                (key, p.file.as_str(), rec_p(p))
+            }),
+        );
+        self.check_unique(
+            "model name",
+            f.models.iter().flat_map(|m| {
+                let rec = format!("model {:?}", m.id);
+                let mut names: Vec<String> = m.folded_names().collect();
+                names.sort();
+                names.dedup();
+                names.into_iter().map(move |n| (n, m.file.as_str(), rec.clone()))
+            }),
+        );
+        self.check_unique("bitfield id", f.bitfields.iter().map(|b| (b.id.clone(), b.file.as_str(), format!("bitfield {:?}", b.id))));
+        self.check_unique("requirement id", f.requirements.iter().map(|r| (r.id.clone(), r.file.as_str(), format!("requirement {:?}", r.id))));
+        self.check_unique("erratum id", f.errata.iter().map(|e| (e.id.clone(), e.file.as_str(), format!("erratum {:?}", e.id))));
+        self.check_unique("vector id", f.vectors.iter().map(|v| (v.id.clone(), v.file.as_str(), format!("vector {:?}", v.id))));
+    }
+
+    fn parameters(&mut self) {
+        let f = self.family;
+        for p in &f.parameters {
+            let rec = rec_p(p);
+            if let (Some(range), Some((lo, hi))) = (&p.range, p.data_type.bounds()) {
+                for [min, max] in range.intervals() {
+                    if min > max {
+                        self.push(&p.file, rec.clone(), ProblemKind::BadRange { min: *min, max: *max, reason: "has min > max" });
+                    } else if *min < lo || *max > hi {
+                        self.push(&p.file, rec.clone(), ProblemKind::BadRange { min: *min, max: *max, reason: "exceeds the data type" });
+                    }
+                }
+            }
+            if p.data_type == crate::DataType::String && p.default.is_some() {
+                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message: "a string parameter takes default_text, not default".into() });
+            }
+            if let Some(s) = p.size {
+                if ![1, 2, 4].contains(&s) {
+                    self.push(&p.file, rec.clone(), ProblemKind::Invalid { message: format!("size {s}, expected 1, 2 or 4") });
+                }
+            }
+            if p.address.is_some() != p.size.is_some() {
+                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message: "address and size go together".into() });
+            }
+            for m in &p.modes {
+                if let (Some(range), Some(d)) = (&m.range, m.default) {
+                    if !range.contains(d) {
+                        let range = range.to_string();
+                        self.push(&p.file, rec.clone(), ProblemKind::OutOfRange { what: "mode default", value: d, range, model: None });
+                    }
+                }
+            }
+            // Defaults and enumerated values inside the range, for the parameter and each model.
+            let mut contexts: Vec<Option<&crate::DeviceModel>> = vec![None];
+            contexts.extend(f.models.iter().map(Some));
+            for model in contexts {
+                if model.is_none() && (p.range_model || p.default_model) {
+                    continue;
+                }
+                let r = f.resolve(p, model);
+                let Some(range) = r.range else { continue };
+                let model_id = model.map(|m| m.id.clone());
+                if let Some(d) = r.default {
+                    if !range.contains(d) {
+                        let kind = ProblemKind::OutOfRange { what: "default", value: d, range: range.to_string(), model: model_id.clone() };
+                        self.push(&p.file, rec.clone(), kind);
+                    }
+                }
+                if model.is_none() {
+                    for v in &p.values {
+                        if !range.contains(v.value) {
+                            let kind = ProblemKind::OutOfRange { what: "enumerated value", value: v.value, range: range.to_string(), model: None };
+                            self.push(&p.file, rec.clone(), kind);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn addresses(&mut self) {
+        let mut spans: Vec<(u32, u32, &Parameter)> = self
+            .family
+            .parameters
+            .iter()
+            .filter_map(|p| Some((p.address?, p.address?.saturating_add(p.size?), p)))
+            .collect();
+        spans.sort_by_key(|(a, _, _)| *a);
+        for pair in spans.windows(2) {
+            if let [(_, end_a, a), (start_b, end_b, b)] = pair {
+                if start_b < end_a {
+                    let kind = ProblemKind::AddressOverlap { address: *start_b, end: *end_b, other: a.id.clone() };
+                    self.push(&b.file, rec_p(b), kind);
+                }
+            }
+        }
+    }
+
+    fn models(&mut self) {
+        let f = self.family;
+        for m in &f.models {
+            let rec = format!("model {:?}", m.id);
+            for mp in &m.params {
+                if f.parameters.iter().all(|p| p.id != mp.id) {
+                    self.dangling(&m.file, rec.clone(), "parameter", &mp.id);
+                }
+            }
+            for p in &f.parameters {
+                let given = m.params.iter().find(|mp| mp.id == p.id);
+                if p.range_model && given.and_then(|g| g.range.as_ref()).is_none() {
+                    self.push(&m.file, rec.clone(), ProblemKind::ModelValueMissing { model: m.id.clone(), param: p.id.clone(), what: "range" });
+                }
+                if p.default_model && given.and_then(|g| g.default).is_none() {
+                    self.push(&m.file, rec.clone(), ProblemKind::ModelValueMissing { model: m.id.clone(), param: p.id.clone(), what: "default" });
+                }
+            }
+        }
+    }
+
+    fn bitfields(&mut self) {
+        let f = self.family;
+        for b in &f.bitfields {
+            let rec = format!("bitfield {:?}", b.id);
+            if f.parameter(&b.param).is_none() {
+                self.dangling(&b.file, rec.clone(), "parameter", &b.param);
+            }
+            if ![8, 16, 32].contains(&b.width) {
+                self.push(&b.file, rec.clone(), ProblemKind::Invalid { message: format!("width {}, expected 8, 16 or 32", b.width) });
+            }
+            let mut seen = Vec::new();
+            for bit in &b.bits {
+                let brec = format!("{rec} bit {}", bit.bit);
+                if bit.bit >= b.width {
+                    self.push(&b.file, brec.clone(), ProblemKind::Invalid { message: format!("bit {} outside width {}", bit.bit, b.width) });
+                }
+                if seen.contains(&bit.bit) {
+                    self.push(&b.file, brec.clone(), ProblemKind::Duplicate { what: "bit", id: bit.bit.to_string(), first: b.file.clone() });
+                }
+                seen.push(bit.bit);
+                for rule in &bit.rules {
+                    if f.requirement(&rule.requirement).is_none() {
+                        self.dangling(&b.file, brec.clone(), "requirement", &rule.requirement);
+                    }
+                    if !is_token(&rule.trigger) {
+                        self.push(&b.file, brec.clone(), ProblemKind::BadId { id: rule.trigger.clone(), pattern: "a kebab-case token" });
+                    }
+                    for other in &rule.priority_over {
+                        if b.bit(*other).is_none() {
+                            self.dangling(&b.file, brec.clone(), "bit", &other.to_string());
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn requirements(&mut self) {
+        let f = self.family;
+        let prefix = f.id().requirement_prefix();
+        for r in &f.requirements {
+            let rec = format!("requirement {:?}", r.id);
+            if !is_requirement_id(&r.id, prefix) {
+                self.push(&r.file, rec.clone(), ProblemKind::BadId { id: r.id.clone(), pattern: "^(HPD|PSD|PSX)-[A-Z0-9]+(-[A-Z0-9]+)+$ with the family's prefix" });
+            }
+            for p in &r.params {
+                if f.parameter(p).is_none() {
+                    self.dangling(&r.file, rec.clone(), "parameter", p);
+                }
+            }
+        }
+    }
+
+    fn errata(&mut self) {
+        let f = self.family;
+        let prefix = format!("{}-ERRATUM-", f.id().requirement_prefix());
+        for e in &f.errata {
+            let rec = format!("erratum {:?}", e.id);
+            if !e.id.starts_with(&prefix) {
+                self.push(&e.file, rec.clone(), ProblemKind::BadId { id: e.id.clone(), pattern: "<PREFIX>-ERRATUM-<NNN>" });
+            }
+            if e.readings.len() < 2 {
+                self.push(&e.file, rec.clone(), ProblemKind::Invalid { message: format!("{} reading(s), expected at least 2", e.readings.len()) });
+            }
+            if e.adopted_reading().is_none() {
+                self.dangling(&e.file, rec.clone(), "reading", &e.adopted);
+            }
+            for r in &e.requirements {
+                if f.requirement(r).is_none() {
+                    self.dangling(&e.file, rec.clone(), "requirement", r);
+                }
+            }
+        }
+    }
+
+    fn vectors(&mut self) {
+        let f = self.family;
+        for v in &f.vectors {
+            let rec = format!("vector {:?}", v.id);
+            for r in &v.requirements {
+                if f.requirement(r).is_none() {
+                    self.dangling(&v.file, rec.clone(), "requirement", r);
+                }
+            }
+            if let Some(m) = &v.model {
+                if f.model(m).is_none() {
+                    self.dangling(&v.file, rec.clone(), "model", m);
+                }
+            }
+        }
+    }
+}
+
+fn rec_p(p: &Parameter) -> String {
+    format!("parameter {:?}", p.id)
+}
+
+/// `abc-def-1`.
+fn is_token(s: &str) -> bool {
+    !s.is_empty()
+        && !s.starts_with('-')
+        && !s.ends_with('-')
+        && s.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+}
+
+/// `^(HPD|PSD|PSX)-[A-Z0-9]+(-[A-Z0-9]+)+$` with the family's prefix.
+fn is_requirement_id(id: &str, prefix: &str) -> bool {
+    let mut parts = id.split('-');
+    parts.next() == Some(prefix)
+        && id.split('-').count() >= 3
+        && parts.all(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_uppercase() || c.is_ascii_digit()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requirement_ids() {
+        assert!(is_requirement_id("PSD-STS-10-RESET", "PSD"));
+        assert!(is_requirement_id("HPD-FRAME-004", "HPD"));
+        assert!(!is_requirement_id("HPD-FRAME", "HPD"));
+        assert!(!is_requirement_id("PSD-FRAME-004", "HPD"));
+        assert!(!is_requirement_id("HPD-frame-004", "HPD"));
+        assert!(!is_requirement_id("HPD--004", "HPD"));
+    }
+}
