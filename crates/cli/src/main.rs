@@ -19,6 +19,15 @@ enum Command {
     Spec(spec_cmd::SpecArgs),
 }
 
+/// Output format of a command.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum Format {
+    /// Text for people.
+    Text,
+    /// JSON, stable and documented in the README.
+    Json,
+}
+
 /// What a command found: exit 0 = pass, 1 = violations or failures found.
 pub enum Outcome {
     /// Nothing wrong.
@@ -33,7 +42,9 @@ fn main() -> ExitCode {
         Err(e) => {
             let _ = e.print();
             return match e.kind() {
-                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => ExitCode::SUCCESS,
+                clap::error::ErrorKind::DisplayHelp | clap::error::ErrorKind::DisplayVersion => {
+                    ExitCode::SUCCESS
+                }
                 _ => ExitCode::from(2),
             };
         }

@@ -110,7 +110,10 @@ impl Bitfield {
 
     /// Mask of the bits the master must keep 0.
     pub fn must_be_zero_mask(&self) -> u64 {
-        self.bits.iter().filter(|b| b.must_be_zero && b.bit < 64).fold(0, |m, b| m | 1 << b.bit)
+        self.bits
+            .iter()
+            .filter(|b| b.must_be_zero && b.bit < 64)
+            .fold(0, |m, b| m | 1 << b.bit)
     }
 
     /// Names of the bits set in `word`, in bit order.

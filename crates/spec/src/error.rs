@@ -32,12 +32,24 @@ pub struct Problem {
 impl Problem {
     /// A problem with a whole file.
     pub fn file(file: impl Into<String>, kind: ProblemKind) -> Problem {
-        Problem { file: file.into(), record: None, kind }
+        Problem {
+            file: file.into(),
+            record: None,
+            kind,
+        }
     }
 
     /// A problem with one record of a file.
-    pub fn record(file: impl Into<String>, record: impl Into<String>, kind: ProblemKind) -> Problem {
-        Problem { file: file.into(), record: Some(record.into()), kind }
+    pub fn record(
+        file: impl Into<String>,
+        record: impl Into<String>,
+        kind: ProblemKind,
+    ) -> Problem {
+        Problem {
+            file: file.into(),
+            record: Some(record.into()),
+            kind,
+        }
     }
 }
 

@@ -1,8 +1,7 @@
 //! One manual's part of the spec: its parameters, models, bits, requirements and vectors.
 
 use crate::{
-    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Parameter, Requirement, Resolved,
-    Vector,
+    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Parameter, Requirement, Resolved, Vector,
 };
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -43,7 +42,9 @@ impl FamilyId {
 
     /// Parses a family name (case-insensitive).
     pub fn parse(s: &str) -> Option<FamilyId> {
-        FamilyId::ALL.into_iter().find(|f| f.as_str().eq_ignore_ascii_case(s.trim()))
+        FamilyId::ALL
+            .into_iter()
+            .find(|f| f.as_str().eq_ignore_ascii_case(s.trim()))
     }
 }
 
@@ -119,7 +120,10 @@ impl Family {
     /// A parameter by id (`"63"`, `"0.1"`, `"Pr64"`, case-insensitive), or by exact name.
     pub fn parameter(&self, key: &str) -> Option<&Parameter> {
         let key = key.trim();
-        let bare = key.strip_prefix("par").or_else(|| key.strip_prefix("Par")).unwrap_or(key);
+        let bare = key
+            .strip_prefix("par")
+            .or_else(|| key.strip_prefix("Par"))
+            .unwrap_or(key);
         let bare = bare.trim_start_matches(['.', ' ']);
         self.parameters
             .iter()
@@ -135,7 +139,9 @@ impl Family {
         }
         let digits = key.trim_start_matches(|c: char| !c.is_ascii_digit());
         let n: u32 = digits.parse().ok()?;
-        self.parameters.iter().find(|p| p.number == n && p.subindex.is_none())
+        self.parameters
+            .iter()
+            .find(|p| p.number == n && p.subindex.is_none())
     }
 
     /// HPD: the parameter whose serial bytes include `address`.
@@ -152,7 +158,11 @@ impl Family {
         if q.is_empty() {
             return None;
         }
-        let exact = |q: &str| self.models.iter().find(|m| m.folded_names().any(|n| n == q));
+        let exact = |q: &str| {
+            self.models
+                .iter()
+                .find(|m| m.folded_names().any(|n| n == q))
+        };
         if let Some(m) = exact(&q) {
             return Some(m);
         }
@@ -165,7 +175,10 @@ impl Family {
             }
         }
         // A unique model whose name starts with the query.
-        let mut hits = self.models.iter().filter(|m| m.folded_names().any(|n| n.starts_with(&q)));
+        let mut hits = self
+            .models
+            .iter()
+            .filter(|m| m.folded_names().any(|n| n.starts_with(&q)));
         match (hits.next(), hits.next()) {
             (Some(m), None) => Some(m),
             _ => None,
@@ -183,7 +196,12 @@ impl Family {
         let range = over
             .and_then(|o| o.range.clone())
             .or_else(|| param.range.clone())
-            .or_else(|| param.data_type.bounds().map(|(lo, hi)| crate::Ranges::new(lo, hi)));
+            .or_else(|| {
+                param
+                    .data_type
+                    .bounds()
+                    .map(|(lo, hi)| crate::Ranges::new(lo, hi))
+            });
         let default = over.and_then(|o| o.default).or(param.default);
         Resolved { range, default }
     }

@@ -35,8 +35,13 @@ impl SpecFiles {
         let mut out = SpecFiles::default();
         let mut problems = Vec::new();
         if !dir.is_dir() {
-            let kind = ProblemKind::Io { message: "not a directory".into() };
-            return Err(SpecErrors(vec![Problem::file(dir.display().to_string(), kind)]));
+            let kind = ProblemKind::Io {
+                message: "not a directory".into(),
+            };
+            return Err(SpecErrors(vec![Problem::file(
+                dir.display().to_string(),
+                kind,
+            )]));
         }
         walk(dir, dir, 0, &mut out, &mut problems);
         out.files.sort();
@@ -54,8 +59,10 @@ impl SpecFiles {
         P: Into<String>,
         C: Into<String>,
     {
-        let mut files: Vec<(String, String)> =
-            pairs.into_iter().map(|(p, c)| (p.into(), c.into())).collect();
+        let mut files: Vec<(String, String)> = pairs
+            .into_iter()
+            .map(|(p, c)| (p.into(), c.into()))
+            .collect();
         files.sort();
         SpecFiles { files }
     }
@@ -73,7 +80,10 @@ impl SpecFiles {
 
     /// The contents of one file.
     pub fn get(&self, path: &str) -> Option<&str> {
-        self.files.iter().find(|(p, _)| p == path).map(|(_, c)| c.as_str())
+        self.files
+            .iter()
+            .find(|(p, _)| p == path)
+            .map(|(_, c)| c.as_str())
     }
 
     /// All files in path order.
@@ -90,7 +100,12 @@ fn walk(root: &Path, dir: &Path, depth: usize, out: &mut SpecFiles, problems: &m
     let entries = match std::fs::read_dir(dir) {
         Ok(e) => e,
         Err(e) => {
-            problems.push(Problem::file(name, ProblemKind::Io { message: e.to_string() }));
+            problems.push(Problem::file(
+                name,
+                ProblemKind::Io {
+                    message: e.to_string(),
+                },
+            ));
             return;
         }
     };
@@ -105,20 +120,35 @@ fn walk(root: &Path, dir: &Path, depth: usize, out: &mut SpecFiles, problems: &m
         }
         let shown = path.display().to_string();
         if out.files.len() >= MAX_FILES {
-            problems.push(Problem::file(shown, ProblemKind::TooMany { limit: MAX_FILES }));
+            problems.push(Problem::file(
+                shown,
+                ProblemKind::TooMany { limit: MAX_FILES },
+            ));
             return;
         }
         let size = entry.metadata().map(|m| m.len()).unwrap_or(0);
         if size > MAX_FILE {
-            problems.push(Problem::file(shown, ProblemKind::TooLarge { size, limit: MAX_FILE }));
+            problems.push(Problem::file(
+                shown,
+                ProblemKind::TooLarge {
+                    size,
+                    limit: MAX_FILE,
+                },
+            ));
             continue;
         }
         match std::fs::read_to_string(&path) {
             Ok(text) => {
                 let rel = path.strip_prefix(root).unwrap_or(&path);
-                out.files.push((rel.to_string_lossy().replace('\\', "/"), text));
+                out.files
+                    .push((rel.to_string_lossy().replace('\\', "/"), text));
             }
-            Err(e) => problems.push(Problem::file(shown, ProblemKind::Io { message: e.to_string() })),
+            Err(e) => problems.push(Problem::file(
+                shown,
+                ProblemKind::Io {
+                    message: e.to_string(),
+                },
+            )),
         }
     }
 }

@@ -58,7 +58,11 @@ impl Spec {
     /// Loads and validates a spec from a set of files (paths relative to the spec root).
     pub fn from_files(files: &SpecFiles) -> Result<Spec, SpecErrors> {
         let [hpd, psd4xx, psx3xx] = load::load(files)?;
-        let spec = Spec { hpd, psd4xx, psx3xx };
+        let spec = Spec {
+            hpd,
+            psd4xx,
+            psx3xx,
+        };
         let problems = validate::validate(&spec);
         if problems.is_empty() {
             Ok(spec)

@@ -2,8 +2,8 @@
 
 use crate::error::{Problem, ProblemKind, SpecErrors};
 use crate::{
-    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Family, FamilyId, FamilyInfo,
-    Parameter, Protocol, Requirement, SpecFiles, Vector,
+    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Family, FamilyId, FamilyInfo, Parameter,
+    Protocol, Requirement, SpecFiles, Vector,
 };
 use serde::de::DeserializeOwned;
 
@@ -34,14 +34,22 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
     let mut vectors = Vec::new();
 
     for (path, text) in files.iter().filter(|(p, _)| p.starts_with(&dir)) {
-        let Some(mut table) = parse(path, text, problems) else { continue };
+        let Some(mut table) = parse(path, text, problems) else {
+            continue;
+        };
         if path == family_path {
             info = single::<FamilyInfo>(path, &mut table, "family", problems);
             if let Some(i) = &info {
                 if i.id != id {
                     problems.push(Problem::file(
                         path,
-                        ProblemKind::Invalid { message: format!("family id {:?} in folder {:?}", i.id.as_str(), id.as_str()) },
+                        ProblemKind::Invalid {
+                            message: format!(
+                                "family id {:?} in folder {:?}",
+                                i.id.as_str(),
+                                id.as_str()
+                            ),
+                        },
                     ));
                 }
             }
@@ -49,10 +57,14 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
             protocol = match id {
                 FamilyId::Hpd => single::<hpd::Protocol>(path, &mut table, "protocol", problems)
                     .map(|p| Protocol::Hpd(Box::new(p))),
-                FamilyId::Psd4xx => single::<psd4xx::Protocol>(path, &mut table, "protocol", problems)
-                    .map(|p| Protocol::Psd4xx(Box::new(p))),
-                FamilyId::Psx3xx => single::<psx3xx::Protocol>(path, &mut table, "protocol", problems)
-                    .map(|p| Protocol::Psx3xx(Box::new(p))),
+                FamilyId::Psd4xx => {
+                    single::<psd4xx::Protocol>(path, &mut table, "protocol", problems)
+                        .map(|p| Protocol::Psd4xx(Box::new(p)))
+                }
+                FamilyId::Psx3xx => {
+                    single::<psx3xx::Protocol>(path, &mut table, "protocol", problems)
+                        .map(|p| Protocol::Psx3xx(Box::new(p)))
+                }
             };
         } else if path.starts_with(&format!("{dir}vectors/")) {
             records(path, &mut table, "vector", &mut vectors, problems);
@@ -75,15 +87,27 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
             };
             problems.push(Problem::file(
                 path,
-                ProblemKind::Schema { message: format!("unknown top-level key `{key}`, expected one of: {allowed}") },
+                ProblemKind::Schema {
+                    message: format!("unknown top-level key `{key}`, expected one of: {allowed}"),
+                },
             ));
         }
     }
     if info.is_none() && !problems.iter().any(|p| p.file == family_path) {
-        problems.push(Problem::file(&family_path, ProblemKind::Missing { what: "file".into() }));
+        problems.push(Problem::file(
+            &family_path,
+            ProblemKind::Missing {
+                what: "file".into(),
+            },
+        ));
     }
     if protocol.is_none() && !problems.iter().any(|p| p.file == protocol_path) {
-        problems.push(Problem::file(&protocol_path, ProblemKind::Missing { what: "file".into() }));
+        problems.push(Problem::file(
+            &protocol_path,
+            ProblemKind::Missing {
+                what: "file".into(),
+            },
+        ));
     }
     Some(Family {
         info: info?,
@@ -101,12 +125,16 @@ fn parse(path: &str, text: &str, problems: &mut Vec<Problem>) -> Option<toml::Ta
     match text.parse::<toml::Table>() {
         Ok(t) => Some(t),
         Err(e) => {
-            let (line, column) = e
-                .span()
-                .map(|s| line_col(text, s.start))
-                .unwrap_or((0, 0));
+            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
             let message = e.message().to_owned();
-            problems.push(Problem::file(path, ProblemKind::Syntax { line, column, message }));
+            problems.push(Problem::file(
+                path,
+                ProblemKind::Syntax {
+                    line,
+                    column,
+                    message,
+                },
+            ));
             None
         }
     }
@@ -128,13 +156,24 @@ fn single<T: DeserializeOwned>(
     problems: &mut Vec<Problem>,
 ) -> Option<T> {
     let Some(value) = table.remove(key) else {
-        problems.push(Problem::file(path, ProblemKind::Missing { what: format!("table [{key}]") }));
+        problems.push(Problem::file(
+            path,
+            ProblemKind::Missing {
+                what: format!("table [{key}]"),
+            },
+        ));
         return None;
     };
     match value.try_into::<T>() {
         Ok(v) => Some(v),
         Err(e) => {
-            problems.push(Problem::record(path, format!("[{key}]"), ProblemKind::Schema { message: e.message().to_owned() }));
+            problems.push(Problem::record(
+                path,
+                format!("[{key}]"),
+                ProblemKind::Schema {
+                    message: e.message().to_owned(),
+                },
+            ));
             None
         }
     }
@@ -154,7 +193,14 @@ macro_rules! record {
         }
     )*};
 }
-record!(Parameter, DeviceModel, Bitfield, Requirement, Erratum, Vector);
+record!(
+    Parameter,
+    DeviceModel,
+    Bitfield,
+    Requirement,
+    Erratum,
+    Vector
+);
 
 /// Deserialises every element of the array `key` (removing it from `table`).
 fn records<T: Record>(
@@ -164,9 +210,16 @@ fn records<T: Record>(
     out: &mut Vec<T>,
     problems: &mut Vec<Problem>,
 ) {
-    let Some(value) = table.remove(key) else { return };
+    let Some(value) = table.remove(key) else {
+        return;
+    };
     let toml::Value::Array(items) = value else {
-        problems.push(Problem::file(path, ProblemKind::Schema { message: format!("`{key}` must be an array of tables ([[{key}]])") }));
+        problems.push(Problem::file(
+            path,
+            ProblemKind::Schema {
+                message: format!("`{key}` must be an array of tables ([[{key}]])"),
+            },
+        ));
         return;
     };
     for (i, item) in items.into_iter().enumerate() {
@@ -176,7 +229,13 @@ fn records<T: Record>(
                 r.set_file(path);
                 out.push(r);
             }
-            Err(e) => problems.push(Problem::record(path, label, ProblemKind::Schema { message: e.message().to_owned() })),
+            Err(e) => problems.push(Problem::record(
+                path,
+                label,
+                ProblemKind::Schema {
+                    message: e.message().to_owned(),
+                },
+            )),
         }
     }
 }

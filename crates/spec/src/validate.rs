@@ -8,7 +8,10 @@ use std::collections::BTreeMap;
 pub(crate) fn validate(spec: &Spec) -> Vec<Problem> {
     let mut problems = Vec::new();
     for family in spec.families() {
-        let mut v = Validator { family, problems: &mut problems };
+        let mut v = Validator {
+            family,
+            problems: &mut problems,
+        };
         v.unique_ids();
         v.parameters();
         v.addresses();
@@ -32,15 +35,34 @@ impl Validator<'_> {
     }
 
     fn dangling(&mut self, file: &str, record: String, what: &'static str, id: &str) {
-        self.push(file, record, ProblemKind::Dangling { what, id: id.to_owned() });
+        self.push(
+            file,
+            record,
+            ProblemKind::Dangling {
+                what,
+                id: id.to_owned(),
+            },
+        );
     }
 
-    fn check_unique<'k>(&mut self, what: &'static str, items: impl Iterator<Item = (String, &'k str, String)>) {
+    fn check_unique<'k>(
+        &mut self,
+        what: &'static str,
+        items: impl Iterator<Item = (String, &'k str, String)>,
+    ) {
         let mut seen: BTreeMap<String, &str> = BTreeMap::new();
         for (key, file, record) in items {
             if let Some(first) = seen.get(&key) {
                 let first = (*first).to_owned();
-                self.push(file, record, ProblemKind::Duplicate { what, id: key, first });
+                self.push(
+                    file,
+                    record,
+                    ProblemKind::Duplicate {
+                        what,
+                        id: key,
+                        first,
+                    },
+                );
             } else {
                 seen.insert(key, file);
             }
@@ -49,7 +71,12 @@ impl Validator<'_> {
 
     fn unique_ids(&mut self) {
         let f = self.family;
-        self.check_unique("parameter id", f.parameters.iter().map(|p| (p.id.to_lowercase(), p.file.as_str(), rec_p(p))));
+        self.check_unique(
+            "parameter id",
+            f.parameters
+                .iter()
+                .map(|p| (p.id.to_lowercase(), p.file.as_str(), rec_p(p))),
+        );
         self.check_unique(
             "parameter number",
             f.parameters.iter().map(|p| {
@@ -67,13 +94,43 @@ impl Validator<'_> {
                 let mut names: Vec<String> = m.folded_names().collect();
                 names.sort();
                 names.dedup();
-                names.into_iter().map(move |n| (n, m.file.as_str(), rec.clone()))
+                names
+                    .into_iter()
+                    .map(move |n| (n, m.file.as_str(), rec.clone()))
             }),
         );
-        self.check_unique("bitfield id", f.bitfields.iter().map(|b| (b.id.clone(), b.file.as_str(), format!("bitfield {:?}", b.id))));
-        self.check_unique("requirement id", f.requirements.iter().map(|r| (r.id.clone(), r.file.as_str(), format!("requirement {:?}", r.id))));
-        self.check_unique("erratum id", f.errata.iter().map(|e| (e.id.clone(), e.file.as_str(), format!("erratum {:?}", e.id))));
-        self.check_unique("vector id", f.vectors.iter().map(|v| (v.id.clone(), v.file.as_str(), format!("vector {:?}", v.id))));
+        self.check_unique(
+            "bitfield id",
+            f.bitfields.iter().map(|b| {
+                (
+                    b.id.clone(),
+                    b.file.as_str(),
+                    format!("bitfield {:?}", b.id),
+                )
+            }),
+        );
+        self.check_unique(
+            "requirement id",
+            f.requirements.iter().map(|r| {
+                (
+                    r.id.clone(),
+                    r.file.as_str(),
+                    format!("requirement {:?}", r.id),
+                )
+            }),
+        );
+        self.check_unique(
+            "erratum id",
+            f.errata
+                .iter()
+                .map(|e| (e.id.clone(), e.file.as_str(), format!("erratum {:?}", e.id))),
+        );
+        self.check_unique(
+            "vector id",
+            f.vectors
+                .iter()
+                .map(|v| (v.id.clone(), v.file.as_str(), format!("vector {:?}", v.id))),
+        );
     }
 
     fn parameters(&mut self) {
@@ -83,28 +140,71 @@ impl Validator<'_> {
             if let (Some(range), Some((lo, hi))) = (&p.range, p.data_type.bounds()) {
                 for [min, max] in range.intervals() {
                     if min > max {
-                        self.push(&p.file, rec.clone(), ProblemKind::BadRange { min: *min, max: *max, reason: "has min > max" });
+                        self.push(
+                            &p.file,
+                            rec.clone(),
+                            ProblemKind::BadRange {
+                                min: *min,
+                                max: *max,
+                                reason: "has min > max",
+                            },
+                        );
                     } else if *min < lo || *max > hi {
-                        self.push(&p.file, rec.clone(), ProblemKind::BadRange { min: *min, max: *max, reason: "exceeds the data type" });
+                        self.push(
+                            &p.file,
+                            rec.clone(),
+                            ProblemKind::BadRange {
+                                min: *min,
+                                max: *max,
+                                reason: "exceeds the data type",
+                            },
+                        );
                     }
                 }
             }
             if p.data_type == crate::DataType::String && p.default.is_some() {
-                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message: "a string parameter takes default_text, not default".into() });
+                self.push(
+                    &p.file,
+                    rec.clone(),
+                    ProblemKind::Invalid {
+                        message: "a string parameter takes default_text, not default".into(),
+                    },
+                );
             }
             if let Some(s) = p.size {
                 if ![1, 2, 4].contains(&s) {
-                    self.push(&p.file, rec.clone(), ProblemKind::Invalid { message: format!("size {s}, expected 1, 2 or 4") });
+                    self.push(
+                        &p.file,
+                        rec.clone(),
+                        ProblemKind::Invalid {
+                            message: format!("size {s}, expected 1, 2 or 4"),
+                        },
+                    );
                 }
             }
             if p.address.is_some() != p.size.is_some() {
-                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message: "address and size go together".into() });
+                self.push(
+                    &p.file,
+                    rec.clone(),
+                    ProblemKind::Invalid {
+                        message: "address and size go together".into(),
+                    },
+                );
             }
             for m in &p.modes {
                 if let (Some(range), Some(d)) = (&m.range, m.default) {
                     if !range.contains(d) {
                         let range = range.to_string();
-                        self.push(&p.file, rec.clone(), ProblemKind::OutOfRange { what: "mode default", value: d, range, model: None });
+                        self.push(
+                            &p.file,
+                            rec.clone(),
+                            ProblemKind::OutOfRange {
+                                what: "mode default",
+                                value: d,
+                                range,
+                                model: None,
+                            },
+                        );
                     }
                 }
             }
@@ -120,14 +220,24 @@ impl Validator<'_> {
                 let model_id = model.map(|m| m.id.clone());
                 if let Some(d) = r.default {
                     if !range.contains(d) {
-                        let kind = ProblemKind::OutOfRange { what: "default", value: d, range: range.to_string(), model: model_id.clone() };
+                        let kind = ProblemKind::OutOfRange {
+                            what: "default",
+                            value: d,
+                            range: range.to_string(),
+                            model: model_id.clone(),
+                        };
                         self.push(&p.file, rec.clone(), kind);
                     }
                 }
                 if model.is_none() {
                     for v in &p.values {
                         if !range.contains(v.value) {
-                            let kind = ProblemKind::OutOfRange { what: "enumerated value", value: v.value, range: range.to_string(), model: None };
+                            let kind = ProblemKind::OutOfRange {
+                                what: "enumerated value",
+                                value: v.value,
+                                range: range.to_string(),
+                                model: None,
+                            };
                             self.push(&p.file, rec.clone(), kind);
                         }
                     }
@@ -147,7 +257,11 @@ impl Validator<'_> {
         for pair in spans.windows(2) {
             if let [(_, end_a, a), (start_b, end_b, b)] = pair {
                 if start_b < end_a {
-                    let kind = ProblemKind::AddressOverlap { address: *start_b, end: *end_b, other: a.id.clone() };
+                    let kind = ProblemKind::AddressOverlap {
+                        address: *start_b,
+                        end: *end_b,
+                        other: a.id.clone(),
+                    };
                     self.push(&b.file, rec_p(b), kind);
                 }
             }
@@ -166,10 +280,26 @@ impl Validator<'_> {
             for p in &f.parameters {
                 let given = m.params.iter().find(|mp| mp.id == p.id);
                 if p.range_model && given.and_then(|g| g.range.as_ref()).is_none() {
-                    self.push(&m.file, rec.clone(), ProblemKind::ModelValueMissing { model: m.id.clone(), param: p.id.clone(), what: "range" });
+                    self.push(
+                        &m.file,
+                        rec.clone(),
+                        ProblemKind::ModelValueMissing {
+                            model: m.id.clone(),
+                            param: p.id.clone(),
+                            what: "range",
+                        },
+                    );
                 }
                 if p.default_model && given.and_then(|g| g.default).is_none() {
-                    self.push(&m.file, rec.clone(), ProblemKind::ModelValueMissing { model: m.id.clone(), param: p.id.clone(), what: "default" });
+                    self.push(
+                        &m.file,
+                        rec.clone(),
+                        ProblemKind::ModelValueMissing {
+                            model: m.id.clone(),
+                            param: p.id.clone(),
+                            what: "default",
+                        },
+                    );
                 }
             }
         }
@@ -183,16 +313,36 @@ impl Validator<'_> {
                 self.dangling(&b.file, rec.clone(), "parameter", &b.param);
             }
             if ![8, 16, 32].contains(&b.width) {
-                self.push(&b.file, rec.clone(), ProblemKind::Invalid { message: format!("width {}, expected 8, 16 or 32", b.width) });
+                self.push(
+                    &b.file,
+                    rec.clone(),
+                    ProblemKind::Invalid {
+                        message: format!("width {}, expected 8, 16 or 32", b.width),
+                    },
+                );
             }
             let mut seen = Vec::new();
             for bit in &b.bits {
                 let brec = format!("{rec} bit {}", bit.bit);
                 if bit.bit >= b.width {
-                    self.push(&b.file, brec.clone(), ProblemKind::Invalid { message: format!("bit {} outside width {}", bit.bit, b.width) });
+                    self.push(
+                        &b.file,
+                        brec.clone(),
+                        ProblemKind::Invalid {
+                            message: format!("bit {} outside width {}", bit.bit, b.width),
+                        },
+                    );
                 }
                 if seen.contains(&bit.bit) {
-                    self.push(&b.file, brec.clone(), ProblemKind::Duplicate { what: "bit", id: bit.bit.to_string(), first: b.file.clone() });
+                    self.push(
+                        &b.file,
+                        brec.clone(),
+                        ProblemKind::Duplicate {
+                            what: "bit",
+                            id: bit.bit.to_string(),
+                            first: b.file.clone(),
+                        },
+                    );
                 }
                 seen.push(bit.bit);
                 for rule in &bit.rules {
@@ -200,7 +350,14 @@ impl Validator<'_> {
                         self.dangling(&b.file, brec.clone(), "requirement", &rule.requirement);
                     }
                     if !is_token(&rule.trigger) {
-                        self.push(&b.file, brec.clone(), ProblemKind::BadId { id: rule.trigger.clone(), pattern: "a kebab-case token" });
+                        self.push(
+                            &b.file,
+                            brec.clone(),
+                            ProblemKind::BadId {
+                                id: rule.trigger.clone(),
+                                pattern: "a kebab-case token",
+                            },
+                        );
                     }
                     for other in &rule.priority_over {
                         if b.bit(*other).is_none() {
@@ -218,7 +375,14 @@ impl Validator<'_> {
         for r in &f.requirements {
             let rec = format!("requirement {:?}", r.id);
             if !is_requirement_id(&r.id, prefix) {
-                self.push(&r.file, rec.clone(), ProblemKind::BadId { id: r.id.clone(), pattern: "^(HPD|PSD|PSX)-[A-Z0-9]+(-[A-Z0-9]+)+$ with the family's prefix" });
+                self.push(
+                    &r.file,
+                    rec.clone(),
+                    ProblemKind::BadId {
+                        id: r.id.clone(),
+                        pattern: "^(HPD|PSD|PSX)-[A-Z0-9]+(-[A-Z0-9]+)+$ with the family's prefix",
+                    },
+                );
             }
             for p in &r.params {
                 if f.parameter(p).is_none() {
@@ -234,10 +398,23 @@ impl Validator<'_> {
         for e in &f.errata {
             let rec = format!("erratum {:?}", e.id);
             if !e.id.starts_with(&prefix) {
-                self.push(&e.file, rec.clone(), ProblemKind::BadId { id: e.id.clone(), pattern: "<PREFIX>-ERRATUM-<NNN>" });
+                self.push(
+                    &e.file,
+                    rec.clone(),
+                    ProblemKind::BadId {
+                        id: e.id.clone(),
+                        pattern: "<PREFIX>-ERRATUM-<NNN>",
+                    },
+                );
             }
             if e.readings.len() < 2 {
-                self.push(&e.file, rec.clone(), ProblemKind::Invalid { message: format!("{} reading(s), expected at least 2", e.readings.len()) });
+                self.push(
+                    &e.file,
+                    rec.clone(),
+                    ProblemKind::Invalid {
+                        message: format!("{} reading(s), expected at least 2", e.readings.len()),
+                    },
+                );
             }
             if e.adopted_reading().is_none() {
                 self.dangling(&e.file, rec.clone(), "reading", &e.adopted);
@@ -277,7 +454,8 @@ fn is_token(s: &str) -> bool {
     !s.is_empty()
         && !s.starts_with('-')
         && !s.ends_with('-')
-        && s.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+        && s.chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
 }
 
 /// `^(HPD|PSD|PSX)-[A-Z0-9]+(-[A-Z0-9]+)+$` with the family's prefix.
@@ -285,7 +463,11 @@ fn is_requirement_id(id: &str, prefix: &str) -> bool {
     let mut parts = id.split('-');
     parts.next() == Some(prefix)
         && id.split('-').count() >= 3
-        && parts.all(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_uppercase() || c.is_ascii_digit()))
+        && parts.all(|p| {
+            !p.is_empty()
+                && p.chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
+        })
 }
 
 #[cfg(test)]

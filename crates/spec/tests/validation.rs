@@ -1,0 +1,483 @@
+//! One broken spec per validation rule: each must give exactly its one clear error.
+#![allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+
+use drivespec_spec::{Spec, SpecFiles};
+
+/// The built-in family and protocol files, with no records.
+fn skeleton() -> SpecFiles {
+    let builtin = SpecFiles::builtin();
+    SpecFiles::from_pairs(
+        builtin
+            .iter()
+            .filter(|(p, _)| p.ends_with("/family.toml") || p.ends_with("/protocol.toml"))
+            .map(|(p, c)| (p.to_owned(), c.to_owned())),
+    )
+}
+
+const PARAM: &str = r#"
+[[parameter]]
+id = "44"
+number = 44
+name = "Positioning window"
+type = "u16"
+range = [[1, 100]]
+default = 2
+access = "rw"
+source = "3.3"
+"#;
+
+const REQ: &str = r#"
+[[requirement]]
+id = "PSD-PAR-044"
+level = "must"
+text = "the positioning window is 1 to 100"
+source = "3.3"
+"#;
+
+/// Loads the skeleton plus `psd4xx/test.toml` and returns the problems as lines.
+fn problems_with(file: &str, contents: &str) -> Vec<String> {
+    let mut files = skeleton();
+    files.set(file, contents);
+    match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    }
+}
+
+fn one_problem(contents: &str) -> String {
+    let problems = problems_with("psd4xx/test.toml", contents);
+    assert_eq!(
+        problems.len(),
+        1,
+        "expected exactly one problem, got {problems:#?}"
+    );
+    problems.into_iter().next().unwrap_or_default()
+}
+
+#[test]
+fn skeleton_and_sample_records_are_valid() {
+    assert_eq!(
+        problems_with("psd4xx/test.toml", &format!("{PARAM}{REQ}")),
+        Vec::<String>::new()
+    );
+}
+
+#[test]
+fn unknown_key_is_rejected() {
+    let p = one_problem(&PARAM.replace("range =", "rnage ="));
+    assert!(
+        p.starts_with(r#"psd4xx/test.toml: parameter "44": unknown field `rnage`"#),
+        "{p}"
+    );
+}
+
+#[test]
+fn unknown_top_level_key_is_rejected() {
+    let p = one_problem("[[parametr]]\nid = \"1\"\n");
+    assert_eq!(p, "psd4xx/test.toml: unknown top-level key `parametr`, expected one of: parameter, model, bitfield, requirement, erratum");
+}
+
+#[test]
+fn syntax_error_names_line_and_column() {
+    let p = one_problem("[[parameter]]\nid = \"1\nnumber = 1\n");
+    assert!(
+        p.starts_with("psd4xx/test.toml: invalid TOML at line 2, column"),
+        "{p}"
+    );
+}
+
+#[test]
+fn missing_required_key_is_rejected() {
+    let p = one_problem(&PARAM.replace("source = \"3.3\"\n", ""));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": missing field `source`"#
+    );
+}
+
+#[test]
+fn duplicate_parameter_id_is_rejected() {
+    let p = one_problem(&format!(
+        "{PARAM}{}",
+        PARAM.replace("number = 44", "number = 45")
+    ));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": duplicate parameter id "44" (first in psd4xx/test.toml)"#
+    );
+}
+
+#[test]
+fn duplicate_parameter_number_is_rejected() {
+    let p = one_problem(&format!(
+        "{PARAM}{}",
+        PARAM.replace("id = \"44\"", "id = \"x44\"")
+    ));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "x44": duplicate parameter number "44" (first in psd4xx/test.toml)"#
+    );
+}
+
+#[test]
+fn default_outside_range_is_rejected() {
+    let p = one_problem(&PARAM.replace("default = 2", "default = 0"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": default 0 outside range 1..100"#
+    );
+}
+
+#[test]
+fn range_beyond_data_type_is_rejected() {
+    let p = one_problem(&PARAM.replace("[[1, 100]]", "[[1, 70000]]"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": range 1..70000 exceeds the data type"#
+    );
+}
+
+#[test]
+fn inverted_range_is_rejected() {
+    let p = one_problem(&PARAM.replace("[[1, 100]]", "[[1, 100], [9, 3]]"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": range 9..3 has min > max"#
+    );
+}
+
+#[test]
+fn enumerated_value_outside_range_is_rejected() {
+    let extra = "[[parameter.value]]\nvalue = 200\nname = \"big\"\nmeaning = \"too big\"\n";
+    let p = one_problem(&format!("{PARAM}{extra}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": enumerated value 200 outside range 1..100"#
+    );
+}
+
+const MODEL: &str = r#"
+[[model]]
+id = "PSD426-14H"
+name = "PSD 426/436-14H"
+aliases = ["PSD426"]
+source = "3.4"
+"#;
+
+#[test]
+fn model_default_outside_its_range_is_rejected() {
+    let m = format!("{MODEL}[[model.param]]\nid = \"44\"\nrange = [[1, 50]]\ndefault = 60\n");
+    let p = one_problem(&format!("{PARAM}{m}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: parameter "44": default 60 outside range 1..50 for model PSD426-14H"#
+    );
+}
+
+#[test]
+fn model_dependent_value_must_come_from_every_model() {
+    let param = PARAM.replace("default = 2", "default_model = true");
+    let p = one_problem(&format!("{param}{MODEL}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: model "PSD426-14H": model "PSD426-14H" gives no default for parameter "44""#
+    );
+}
+
+#[test]
+fn model_param_must_exist() {
+    let m = format!("{MODEL}[[model.param]]\nid = \"99\"\ndefault = 1\n");
+    let p = one_problem(&m);
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: model "PSD426-14H": parameter "99" does not exist"#
+    );
+}
+
+#[test]
+fn model_names_must_be_unique_after_folding() {
+    let other = MODEL
+        .replace("PSD426-14H", "PSD426-8V")
+        .replace("PSD 426/436-14H", "PSD 426-8V")
+        .replace("[\"PSD426\"]", "[\"psd-426\"]");
+    let p = one_problem(&format!("{MODEL}{other}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: model "PSD426-8V": duplicate model name "psd426" (first in psd4xx/test.toml)"#
+    );
+}
+
+#[test]
+fn serial_addresses_must_not_overlap() {
+    let a = "[[parameter]]\nid = \"Pr7\"\nnumber = 7\nname = \"a\"\ntype = \"i16\"\naccess = \"rw\"\naddress = 0x42\nsize = 2\nsource = \"4.2\"\n";
+    let b = "[[parameter]]\nid = \"Pr8\"\nnumber = 8\nname = \"b\"\ntype = \"u8\"\naccess = \"rw\"\naddress = 0x43\nsize = 1\nsource = \"4.2\"\n";
+    let problems = problems_with("hpd/test.toml", &format!("{a}{b}"));
+    assert_eq!(
+        problems,
+        vec![
+            r#"hpd/test.toml: parameter "Pr8": address 0x043..0x044 overlaps parameter "Pr7""#
+                .to_owned()
+        ]
+    );
+}
+
+#[test]
+fn serial_size_must_be_1_2_or_4() {
+    let a = "[[parameter]]\nid = \"Pr7\"\nnumber = 7\nname = \"a\"\ntype = \"i16\"\naccess = \"rw\"\naddress = 0x42\nsize = 3\nsource = \"4.2\"\n";
+    let problems = problems_with("hpd/test.toml", a);
+    assert_eq!(
+        problems,
+        vec![r#"hpd/test.toml: parameter "Pr7": size 3, expected 1, 2 or 4"#.to_owned()]
+    );
+}
+
+const BITS: &str = r#"
+[[bitfield]]
+id = "status"
+param = "44"
+name = "Status word"
+width = 16
+source = "3.6"
+
+[[bitfield.bit]]
+bit = 0
+name = "Target position reached"
+
+[[bitfield.bit.rule]]
+action = "set"
+trigger = "target-reached"
+requirement = "PSD-PAR-044"
+text = "a target has been reached"
+"#;
+
+#[test]
+fn bitfield_sample_is_valid() {
+    assert_eq!(
+        problems_with("psd4xx/test.toml", &format!("{PARAM}{REQ}{BITS}")),
+        Vec::<String>::new()
+    );
+}
+
+#[test]
+fn bitfield_parameter_must_exist() {
+    let p = one_problem(&format!("{REQ}{BITS}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status": parameter "44" does not exist"#
+    );
+}
+
+#[test]
+fn bit_must_lie_inside_the_width() {
+    let p = one_problem(&format!(
+        "{PARAM}{REQ}{}",
+        BITS.replace("bit = 0", "bit = 16")
+    ));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status" bit 16: bit 16 outside width 16"#
+    );
+}
+
+#[test]
+fn bit_rule_requirement_must_exist() {
+    let p = one_problem(&format!("{PARAM}{BITS}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status" bit 0: requirement "PSD-PAR-044" does not exist"#
+    );
+}
+
+#[test]
+fn bit_rule_trigger_must_be_a_token() {
+    let p = one_problem(&format!(
+        "{PARAM}{REQ}{}",
+        BITS.replace("target-reached", "Target reached")
+    ));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status" bit 0: identifier "Target reached" does not match a kebab-case token"#
+    );
+}
+
+#[test]
+fn bit_priority_must_name_an_existing_bit() {
+    let bits = BITS.replace(
+        "trigger = \"target-reached\"",
+        "trigger = \"target-reached\"\npriority_over = [10]",
+    );
+    let p = one_problem(&format!("{PARAM}{REQ}{bits}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status" bit 0: bit "10" does not exist"#
+    );
+}
+
+#[test]
+fn requirement_id_must_carry_the_family_prefix() {
+    let p = one_problem(&REQ.replace("PSD-PAR-044", "PSX-PAR-044"));
+    assert!(p.starts_with(r#"psd4xx/test.toml: requirement "PSX-PAR-044": identifier "PSX-PAR-044" does not match"#), "{p}");
+}
+
+#[test]
+fn requirement_level_is_checked() {
+    let p = one_problem(&REQ.replace("level = \"must\"", "level = \"may\""));
+    assert!(
+        p.starts_with(r#"psd4xx/test.toml: requirement "PSD-PAR-044": unknown variant `may`"#),
+        "{p}"
+    );
+}
+
+#[test]
+fn duplicate_requirement_across_files_names_the_first_file() {
+    let mut files = skeleton();
+    files.set("psd4xx/a.toml", REQ);
+    files.set("psd4xx/b.toml", REQ);
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(problems, vec![r#"psd4xx/b.toml: requirement "PSD-PAR-044": duplicate requirement id "PSD-PAR-044" (first in psd4xx/a.toml)"#.to_owned()]);
+}
+
+const ERRATUM: &str = r#"
+[[erratum]]
+id = "PSD-ERRATUM-001"
+source = "3.3 par 96"
+title = "-1 listed twice"
+adopted = "save"
+reason = "1 saves"
+
+[[erratum.reading]]
+id = "save"
+text = "-1 sets the delivery state"
+
+[[erratum.reading]]
+id = "other"
+text = "-1 saves"
+"#;
+
+#[test]
+fn erratum_must_adopt_one_of_its_readings() {
+    let p = one_problem(&ERRATUM.replace("adopted = \"save\"", "adopted = \"third\""));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: erratum "PSD-ERRATUM-001": reading "third" does not exist"#
+    );
+}
+
+#[test]
+fn erratum_needs_two_readings() {
+    let one = ERRATUM
+        .split("[[erratum.reading]]\nid = \"other\"")
+        .next()
+        .unwrap_or_default();
+    let p = one_problem(one);
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: erratum "PSD-ERRATUM-001": 1 reading(s), expected at least 2"#
+    );
+}
+
+const VECTOR: &str = r#"
+[[vector]]
+id = "pkw-read-44"
+kind = "pkw"
+source = "3.8"
+description = "read par 44"
+requirements = ["PSD-PAR-044"]
+[vector.input]
+ak = 1
+pnu = 44
+[vector.expect]
+ak = 1
+pwe = 2
+"#;
+
+#[test]
+fn vector_requirements_must_exist() {
+    let problems = problems_with("psd4xx/vectors/test.toml", VECTOR);
+    assert_eq!(problems, vec![r#"psd4xx/vectors/test.toml: vector "pkw-read-44": requirement "PSD-PAR-044" does not exist"#.to_owned()]);
+}
+
+#[test]
+fn vector_kind_must_be_known() {
+    let mut files = skeleton();
+    files.set("psd4xx/test.toml", REQ);
+    files.set(
+        "psd4xx/vectors/test.toml",
+        &VECTOR.replace("kind = \"pkw\"", "kind = \"pkx\""),
+    );
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(problems.len(), 1, "{problems:#?}");
+    assert!(
+        problems[0].starts_with(
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": unknown variant `pkx`"#
+        ),
+        "{problems:#?}"
+    );
+}
+
+#[test]
+fn vectors_folder_holds_only_vectors() {
+    let problems = problems_with("psd4xx/vectors/test.toml", REQ);
+    assert_eq!(problems, vec!["psd4xx/vectors/test.toml: unknown top-level key `requirement`, expected one of: vector".to_owned()]);
+}
+
+#[test]
+fn family_folder_and_id_must_agree() {
+    let mut files = skeleton();
+    let hpd = files
+        .get("hpd/family.toml")
+        .unwrap_or_default()
+        .replace("id = \"hpd\"", "id = \"psd4xx\"");
+    files.set("hpd/family.toml", &hpd);
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(
+        problems,
+        vec![r#"hpd/family.toml: family id "psd4xx" in folder "hpd""#.to_owned()]
+    );
+}
+
+#[test]
+fn missing_family_file_is_reported() {
+    let files = SpecFiles::from_pairs(
+        skeleton()
+            .iter()
+            .filter(|(p, _)| *p != "psx3xx/family.toml")
+            .map(|(p, c)| (p.to_owned(), c.to_owned())),
+    );
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(
+        problems,
+        vec!["psx3xx/family.toml: missing file".to_owned()]
+    );
+}
+
+#[test]
+fn string_parameter_takes_default_text() {
+    let s = "[[parameter]]\nid = \"13\"\nnumber = 13\nname = \"Device model\"\ntype = \"string\"\nlength = 20\ndefault = 1\naccess = \"r\"\nsource = \"3.3\"\n";
+    assert_eq!(
+        one_problem(s),
+        r#"psd4xx/test.toml: parameter "13": a string parameter takes default_text, not default"#
+    );
+}
+
+#[test]
+fn every_problem_is_reported_not_just_the_first() {
+    let bad = format!(
+        "{}{}",
+        PARAM.replace("default = 2", "default = 0"),
+        REQ.replace("PSD-PAR-044", "PSD-X")
+    );
+    assert_eq!(problems_with("psd4xx/test.toml", &bad).len(), 2);
+}
