@@ -57,13 +57,12 @@ impl Spec {
 
     /// Loads and validates a spec from a set of files (paths relative to the spec root).
     pub fn from_files(files: &SpecFiles) -> Result<Spec, SpecErrors> {
-        let [hpd, psd4xx, psx3xx] = load::load(files)?;
-        let spec = Spec {
-            hpd,
-            psd4xx,
-            psx3xx,
+        let (families, mut problems) = load::load(files);
+        let Some([hpd, psd4xx, psx3xx]) = families else {
+            return Err(SpecErrors(problems));
         };
-        let problems = validate::validate(&spec);
+        let spec = Spec { hpd, psd4xx, psx3xx };
+        problems.extend(validate::validate(&spec));
         if problems.is_empty() {
             Ok(spec)
         } else {

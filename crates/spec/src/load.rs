@@ -1,6 +1,6 @@
 //! Parsing spec files into records, remembering which file each came from.
 
-use crate::error::{Problem, ProblemKind, SpecErrors};
+use crate::error::{Problem, ProblemKind};
 use crate::{
     hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Family, FamilyId, FamilyInfo, Parameter,
     Protocol, Requirement, SpecFiles, Vector,
@@ -10,13 +10,15 @@ use serde::de::DeserializeOwned;
 /// Top-level arrays a common file may hold.
 const COMMON_KEYS: [&str; 5] = ["parameter", "model", "bitfield", "requirement", "erratum"];
 
-/// Parses all three families; every problem found is returned.
-pub(crate) fn load(files: &SpecFiles) -> Result<[Family; 3], SpecErrors> {
+/// Parses all three families. Records that do not parse are left out and reported; the
+/// families are returned whenever their `family.toml` and `protocol.toml` parse, so that
+/// validation can report the remaining problems in the same pass.
+pub(crate) fn load(files: &SpecFiles) -> (Option<[Family; 3]>, Vec<Problem>) {
     let mut problems = Vec::new();
     let [h, d, x] = FamilyId::ALL.map(|id| load_family(files, id, &mut problems));
     match (h, d, x) {
-        (Some(h), Some(d), Some(x)) if problems.is_empty() => Ok([h, d, x]),
-        _ => Err(SpecErrors(problems)),
+        (Some(h), Some(d), Some(x)) => (Some([h, d, x]), problems),
+        _ => (None, problems),
     }
 }
 

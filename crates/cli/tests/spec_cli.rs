@@ -1,0 +1,98 @@
+//! The `drivespec spec` commands as a user runs them: exit codes, error lines and output.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
+
+use std::process::Command;
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn drivespec(args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_drivespec")).args(args).output().expect("run drivespec");
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+#[test]
+fn builtin_spec_checks_clean() {
+    let r = drivespec(&["spec", "check"]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert!(r.stdout.ends_with("spec ok\n"), "{}", r.stdout);
+}
+
+#[test]
+fn unknown_device_is_bad_usage() {
+    let r = drivespec(&["spec", "list", "psd5xx"]);
+    assert_eq!(r.code, 2);
+    assert_eq!(r.stderr, "drivespec: unknown device \"psd5xx\"; expected one of: hpd, psd4xx, psx3xx\n");
+}
+
+#[test]
+fn unknown_subcommand_is_bad_usage() {
+    assert_eq!(drivespec(&["spec", "lsit", "hpd"]).code, 2);
+    assert_eq!(drivespec(&[]).code, 2);
+}
+
+#[test]
+fn help_exits_zero() {
+    let r = drivespec(&["--help"]);
+    assert_eq!(r.code, 0);
+    assert!(r.stdout.contains("spec"), "{}", r.stdout);
+}
+
+#[test]
+fn missing_spec_folder_is_unreadable_input() {
+    let r = drivespec(&["spec", "check", "--spec", "/nonexistent/spec"]);
+    assert_eq!(r.code, 2);
+    assert_eq!(r.stderr, "drivespec: cannot read spec folder /nonexistent/spec: not a directory\n");
+}
+
+#[test]
+fn broken_spec_folder_fails_check_with_one_line_per_problem() {
+    let dir = std::env::temp_dir().join(format!("drivespec-broken-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec");
+    copy_dir(std::path::Path::new(src), &dir);
+    std::fs::write(
+        dir.join("psd4xx/zz-broken.toml"),
+        "[[requirement]]\nid = \"PSD-X\"\nlevel = \"must\"\ntext = \"t\"\nsource = \"1\"\n\n[[requirement]]\nid = \"PSD-BROKEN-1\"\nlevel = \"maybe\"\ntext = \"t\"\nsource = \"1\"\n",
+    )
+    .unwrap();
+    let r = drivespec(&["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    let lines: Vec<&str> = r.stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{}", r.stdout);
+    assert!(lines[0].starts_with("psd4xx/zz-broken.toml: requirement \"PSD-BROKEN-1\": unknown variant `maybe`"), "{}", lines[0]);
+    assert!(lines[1].starts_with("psd4xx/zz-broken.toml: requirement \"PSD-X\": identifier \"PSD-X\" does not match"), "{}", lines[1]);
+
+    let json = drivespec(&["spec", "check", "--format", "json", "--spec", "/nonexistent"]);
+    assert_eq!(json.code, 2);
+}
+
+#[test]
+fn check_json_is_machine_readable() {
+    let r = drivespec(&["spec", "check", "--format", "json"]);
+    assert_eq!(r.code, 0);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(v["ok"], true);
+    assert_eq!(v["problems"].as_array().map(Vec::len), Some(0));
+}
+
+fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
