@@ -71,7 +71,9 @@ enum SpecCommand {
 /// Runs `drivespec spec …`.
 pub fn run(args: SpecArgs) -> Result<Outcome> {
     let loaded = match &args.spec {
-        Some(dir) if !dir.is_dir() => bail!("cannot read spec folder {}: not a directory", dir.display()),
+        Some(dir) if !dir.is_dir() => {
+            bail!("cannot read spec folder {}: not a directory", dir.display())
+        }
         Some(dir) => Spec::load_dir(dir),
         None => Spec::builtin(),
     };

@@ -1,5 +1,10 @@
 //! The `drivespec spec` commands as a user runs them: exit codes, error lines and output.
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
 
 use std::process::Command;
 
@@ -10,7 +15,10 @@ struct Run {
 }
 
 fn drivespec(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_drivespec")).args(args).output().expect("run drivespec");
+    let out = Command::new(env!("CARGO_BIN_EXE_drivespec"))
+        .args(args)
+        .output()
+        .expect("run drivespec");
     Run {
         code: out.status.code().unwrap_or(-1),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -29,7 +37,10 @@ fn builtin_spec_checks_clean() {
 fn unknown_device_is_bad_usage() {
     let r = drivespec(&["spec", "list", "psd5xx"]);
     assert_eq!(r.code, 2);
-    assert_eq!(r.stderr, "drivespec: unknown device \"psd5xx\"; expected one of: hpd, psd4xx, psx3xx\n");
+    assert_eq!(
+        r.stderr,
+        "drivespec: unknown device \"psd5xx\"; expected one of: hpd, psd4xx, psx3xx\n"
+    );
 }
 
 #[test]
@@ -49,7 +60,10 @@ fn help_exits_zero() {
 fn missing_spec_folder_is_unreadable_input() {
     let r = drivespec(&["spec", "check", "--spec", "/nonexistent/spec"]);
     assert_eq!(r.code, 2);
-    assert_eq!(r.stderr, "drivespec: cannot read spec folder /nonexistent/spec: not a directory\n");
+    assert_eq!(
+        r.stderr,
+        "drivespec: cannot read spec folder /nonexistent/spec: not a directory\n"
+    );
 }
 
 #[test]
@@ -68,10 +82,29 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
     assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
     let lines: Vec<&str> = r.stdout.lines().collect();
     assert_eq!(lines.len(), 2, "{}", r.stdout);
-    assert!(lines[0].starts_with("psd4xx/zz-broken.toml: requirement \"PSD-BROKEN-1\": unknown variant `maybe`"), "{}", lines[0]);
-    assert!(lines[1].starts_with("psd4xx/zz-broken.toml: requirement \"PSD-X\": identifier \"PSD-X\" does not match"), "{}", lines[1]);
+    assert!(
+        lines[0].starts_with(
+            "psd4xx/zz-broken.toml: requirement \"PSD-BROKEN-1\": unknown variant `maybe`"
+        ),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[1].starts_with(
+            "psd4xx/zz-broken.toml: requirement \"PSD-X\": identifier \"PSD-X\" does not match"
+        ),
+        "{}",
+        lines[1]
+    );
 
-    let json = drivespec(&["spec", "check", "--format", "json", "--spec", "/nonexistent"]);
+    let json = drivespec(&[
+        "spec",
+        "check",
+        "--format",
+        "json",
+        "--spec",
+        "/nonexistent",
+    ]);
     assert_eq!(json.code, 2);
 }
 

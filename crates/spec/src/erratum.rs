@@ -49,3 +49,81 @@ impl Erratum {
         self.readings.iter().find(|r| r.id == self.adopted)
     }
 }
+
+/// The readings chosen for selectable errata: the adopted one unless overridden by name.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Readings {
+    chosen: std::collections::BTreeMap<String, String>,
+}
+
+/// A reading choice that names no selectable erratum or no reading of it.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReadingError {
+    /// No erratum has this option.
+    #[error("no erratum option {option:?}; options: {known}")]
+    UnknownOption {
+        /// The option given.
+        option: String,
+        /// The options there are.
+        known: String,
+    },
+    /// The erratum has no such reading.
+    #[error("erratum option {option:?} has no reading {reading:?}; readings: {known}")]
+    UnknownReading {
+        /// The option.
+        option: String,
+        /// The reading given.
+        reading: String,
+        /// The readings there are.
+        known: String,
+    },
+}
+
+impl Readings {
+    /// Chooses `reading` for the erratum with `option`, checked against the family's errata.
+    pub fn choose(
+        &mut self,
+        family: &crate::Family,
+        option: &str,
+        reading: &str,
+    ) -> Result<(), ReadingError> {
+        let Some(e) = family
+            .errata
+            .iter()
+            .find(|e| e.option.as_deref() == Some(option))
+        else {
+            let known: Vec<&str> = family
+                .errata
+                .iter()
+                .filter_map(|e| e.option.as_deref())
+                .collect();
+            return Err(ReadingError::UnknownOption {
+                option: option.to_owned(),
+                known: known.join(", "),
+            });
+        };
+        if e.readings.iter().all(|r| r.id != reading) {
+            let known: Vec<&str> = e.readings.iter().map(|r| r.id.as_str()).collect();
+            return Err(ReadingError::UnknownReading {
+                option: option.to_owned(),
+                reading: reading.to_owned(),
+                known: known.join(", "),
+            });
+        }
+        self.chosen.insert(option.to_owned(), reading.to_owned());
+        Ok(())
+    }
+
+    /// The reading in force for `option`: the chosen one, else the adopted one.
+    pub fn reading<'f>(&'f self, family: &'f crate::Family, option: &str) -> Option<&'f str> {
+        if let Some(r) = self.chosen.get(option) {
+            return Some(r.as_str());
+        }
+        family
+            .errata
+            .iter()
+            .find(|e| e.option.as_deref() == Some(option))
+            .map(|e| e.adopted.as_str())
+    }
+}

@@ -11,6 +11,7 @@ mod erratum;
 mod error;
 mod family;
 mod files;
+pub mod hex;
 mod load;
 mod parameter;
 mod range;
@@ -24,7 +25,7 @@ pub mod psx3xx;
 
 pub use bitfield::{BitRule, Bitfield, BitfieldBit, BitfieldValue, RuleAction};
 pub use device_model::{DeviceModel, ModelParam};
-pub use erratum::{Erratum, Reading};
+pub use erratum::{Erratum, Reading, ReadingError, Readings};
 pub use error::{Problem, ProblemKind, SpecErrors};
 pub use family::{Family, FamilyId, FamilyInfo, Protocol};
 pub use files::SpecFiles;
@@ -61,7 +62,11 @@ impl Spec {
         let Some([hpd, psd4xx, psx3xx]) = families else {
             return Err(SpecErrors(problems));
         };
-        let spec = Spec { hpd, psd4xx, psx3xx };
+        let spec = Spec {
+            hpd,
+            psd4xx,
+            psx3xx,
+        };
         problems.extend(validate::validate(&spec));
         if problems.is_empty() {
             Ok(spec)

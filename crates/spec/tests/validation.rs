@@ -1,5 +1,10 @@
 //! One broken spec per validation rule: each must give exactly its one clear error.
-#![allow(clippy::indexing_slicing, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![allow(
+    clippy::indexing_slicing,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic
+)]
 
 use drivespec_spec::{Spec, SpecFiles};
 

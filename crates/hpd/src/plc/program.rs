@@ -1,0 +1,174 @@
+//! Whole PLC programs (manual 3.8.1, 4.1): at most 128 bytes / 64 instructions from address 0,
+//! no gaps, ending with END; FIN honoured only as one of the first three instructions.
+
+use super::codec::{Instr, Operands, PlcCodec, PlcError};
+use super::listing::ListingError;
+use drivespec_spec::hpd::{OperandForm, Operation};
+
+/// A decoded program: instructions with their byte addresses, up to and including END.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Program {
+    /// (address, instruction).
+    pub instrs: Vec<(usize, Instr)>,
+}
+
+/// Something in a program the drive ignores or refuses (manual 3.8.1).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ProgramIssue {
+    /// A FIN after the first three instructions or after another instruction: a no-op.
+    FinIgnored {
+        /// Its address.
+        address: usize,
+    },
+    /// An arithmetic operand that is a byte parameter.
+    ByteOperand {
+        /// Address of the instruction.
+        address: usize,
+        /// The parameter (`Pr31`).
+        param: String,
+    },
+    /// More instructions than the PLC holds.
+    TooManyInstructions {
+        /// Instructions counted (arithmetic counts as two).
+        count: usize,
+        /// The limit.
+        limit: usize,
+    },
+}
+
+impl PlcCodec {
+    /// Decodes a program from the PLC area bytes; stops after END.
+    pub fn decode_program(&self, bytes: &[u8]) -> Result<Program, PlcError> {
+        let area = usize::from(self.plc().area_bytes);
+        let bytes = bytes.get(..area.min(bytes.len())).unwrap_or(bytes);
+        let mut instrs = Vec::new();
+        let mut at = 0;
+        while at < bytes.len() {
+            let (instr, len) = self.decode(bytes.get(at..).unwrap_or(&[]), at)?;
+            instrs.push((at, instr));
+            at += len;
+            if self.is_end(&instr) {
+                return Ok(Program { instrs });
+            }
+        }
+        Err(PlcError::NoEnd { limit: bytes.len() })
+    }
+
+    /// The bytes of a program.
+    pub fn encode_program(&self, program: &Program) -> Result<Vec<u8>, PlcError> {
+        let mut out = Vec::with_capacity(usize::from(self.plc().area_bytes));
+        for (_, instr) in &program.instrs {
+            self.encode(instr, &mut out)?;
+        }
+        let limit = usize::from(self.plc().area_bytes);
+        if out.len() > limit {
+            return Err(PlcError::TooLong {
+                bytes: out.len(),
+                limit,
+            });
+        }
+        Ok(out)
+    }
+
+    /// Parses a listing: one instruction per line; `;` or `#` start a comment; blank lines
+    /// and a leading address column (`00:` or `0x00`) are allowed.
+    pub fn parse_listing(&self, text: &str) -> Result<Program, ListingError> {
+        let mut instrs = Vec::new();
+        let mut at = 0;
+        for (i, raw) in text.lines().enumerate() {
+            let line = raw.split([';', '#']).next().unwrap_or("").trim();
+            let line = match line.split_once(':') {
+                Some((addr, rest))
+                    if addr
+                        .trim()
+                        .trim_start_matches("0x")
+                        .chars()
+                        .all(|c| c.is_ascii_hexdigit()) =>
+                {
+                    rest.trim()
+                }
+                _ => line,
+            };
+            if line.is_empty() {
+                continue;
+            }
+            let instr = self.parse_line(line, i + 1)?;
+            instrs.push((at, instr));
+            at += self.length(instr.code).unwrap_or(2);
+        }
+        Ok(Program { instrs })
+    }
+
+    /// The listing of a program, one `address: instruction` line each.
+    pub fn format_program(&self, program: &Program) -> String {
+        program
+            .instrs
+            .iter()
+            .map(|(a, i)| format!("{a:02X}: {}\n", self.format(i)))
+            .collect()
+    }
+
+    /// Whether `instr` is END.
+    pub fn is_end(&self, instr: &Instr) -> bool {
+        matches!(instr.operands, Operands::None { .. })
+            && self
+                .plc()
+                .instruction(instr.code)
+                .is_some_and(|i| i.operands == OperandForm::None)
+    }
+
+    /// Whether `instr` is an arithmetic instruction.
+    pub fn is_arith(&self, instr: &Instr) -> bool {
+        self.plc().instruction(instr.code).is_some_and(|i| {
+            matches!(
+                i.operation,
+                Operation::Add | Operation::Sub | Operation::Mul | Operation::Div
+            )
+        })
+    }
+
+    /// What the drive will ignore or refuse in `program` (manual 3.8.1).
+    pub fn check(&self, program: &Program) -> Vec<ProgramIssue> {
+        let plc = self.plc();
+        let fin = &plc.fast_inputs;
+        let mut issues = Vec::new();
+        let mut leading = true;
+        let mut count = 0usize;
+        for (index, (address, instr)) in program.instrs.iter().enumerate() {
+            count += if self.is_arith(instr) { 2 } else { 1 };
+            match instr.operands {
+                Operands::Fin { .. } => {
+                    let honoured = leading
+                        && index < usize::from(fin.max_count)
+                        && *address <= usize::from(fin.last_address);
+                    if !honoured {
+                        issues.push(ProgramIssue::FinIgnored { address: *address });
+                    }
+                }
+                Operands::Arith { pa, pb, pc, .. } => {
+                    leading = false;
+                    for p in [pa, pb, pc] {
+                        let name = format!("Pr{p}");
+                        let forbidden = plc
+                            .arithmetic
+                            .forbidden_params
+                            .iter()
+                            .any(|f| f == &name || f == &format!("Pb{p}"));
+                        if forbidden {
+                            issues.push(ProgramIssue::ByteOperand {
+                                address: *address,
+                                param: name,
+                            });
+                        }
+                    }
+                }
+                _ => leading = false,
+            }
+        }
+        let limit = usize::from(plc.max_instructions);
+        if count > limit {
+            issues.push(ProgramIssue::TooManyInstructions { count, limit });
+        }
+        issues
+    }
+}
