@@ -1,14 +1,24 @@
 //! `drivespec`: the command-line front end. Parsing and printing only; the work is in the libraries.
 
+mod hpd_cmd;
 mod spec_cmd;
 
+use anyhow::{anyhow, bail, Result};
 use clap::{Parser, Subcommand};
+use drivespec_spec::Spec;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Conformance test suite and protocol fuzzer for PSD4xx, PSx3xx and HPD drives.
 #[derive(Parser)]
 #[command(name = "drivespec", version, about)]
 struct Cli {
+    /// Load the spec from this folder instead of the built-in one.
+    #[arg(long, global = true, value_name = "DIR")]
+    spec: Option<PathBuf>,
+    /// Output format.
+    #[arg(long, global = true, value_enum, default_value_t = Format::Text)]
+    format: Format,
     #[command(subcommand)]
     command: Command,
 }
@@ -17,6 +27,39 @@ struct Cli {
 enum Command {
     /// Browse and check the machine-readable spec.
     Spec(spec_cmd::SpecArgs),
+    /// Decode bytes or a line capture, field by field.
+    Decode {
+        #[command(subcommand)]
+        device: DecodeDevice,
+    },
+    /// Build a message from named fields and print its bytes.
+    Encode {
+        #[command(subcommand)]
+        device: EncodeDevice,
+    },
+    /// Assemble and disassemble PLC programs.
+    Plc {
+        #[command(subcommand)]
+        device: PlcDevice,
+    },
+}
+
+#[derive(Subcommand)]
+enum DecodeDevice {
+    /// HPD serial messages (manual 4.1).
+    Hpd(hpd_cmd::DecodeArgs),
+}
+
+#[derive(Subcommand)]
+enum EncodeDevice {
+    /// HPD serial messages (manual 4.1).
+    Hpd(hpd_cmd::EncodeArgs),
+}
+
+#[derive(Subcommand)]
+enum PlcDevice {
+    /// The HPD pico-PLC (manual 3.8.1, 4.1).
+    Hpd(hpd_cmd::PlcArgs),
 }
 
 /// Output format of a command.
@@ -36,6 +79,40 @@ pub enum Outcome {
     Fail,
 }
 
+/// What every command gets: where the spec comes from and how to print.
+pub struct Context {
+    /// `--spec DIR`.
+    pub spec_dir: Option<PathBuf>,
+    /// `--format`.
+    pub format: Format,
+}
+
+impl Context {
+    /// Loads the spec; an invalid spec is unreadable input.
+    pub fn spec(&self) -> Result<Spec> {
+        let loaded = match &self.spec_dir {
+            Some(dir) if !dir.is_dir() => {
+                bail!("cannot read spec folder {}: not a directory", dir.display())
+            }
+            Some(dir) => Spec::load_dir(dir),
+            None => Spec::builtin(),
+        };
+        loaded.map_err(|e| {
+            let first = e.0.first().map(ToString::to_string).unwrap_or_default();
+            anyhow!(
+                "the spec is invalid ({} problems; run `drivespec spec check`): {first}",
+                e.0.len()
+            )
+        })
+    }
+}
+
+/// Pretty JSON of a value.
+pub fn json<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_string_pretty(v)
+        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -49,8 +126,21 @@ fn main() -> ExitCode {
             };
         }
     };
+    let ctx = Context {
+        spec_dir: cli.spec,
+        format: cli.format,
+    };
     let result = match cli.command {
-        Command::Spec(args) => spec_cmd::run(args),
+        Command::Spec(args) => spec_cmd::run(args, &ctx),
+        Command::Decode {
+            device: DecodeDevice::Hpd(args),
+        } => hpd_cmd::decode(args, &ctx),
+        Command::Encode {
+            device: EncodeDevice::Hpd(args),
+        } => hpd_cmd::encode(args, &ctx),
+        Command::Plc {
+            device: PlcDevice::Hpd(args),
+        } => hpd_cmd::plc(args, &ctx),
     };
     match result {
         Ok(Outcome::Pass) => ExitCode::SUCCESS,

@@ -1,22 +1,15 @@
 //! `drivespec spec …`: browse and check the machine-readable spec.
 
-use crate::{Format, Outcome};
+use crate::{json, Context, Format, Outcome};
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, Subcommand};
 use drivespec_spec::{DeviceModel, Family, FamilyId, Level, Parameter, Ranges, Spec};
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::PathBuf;
 
 /// Arguments of `drivespec spec`.
 #[derive(Args)]
 pub struct SpecArgs {
-    /// Load the spec from this folder instead of the built-in one.
-    #[arg(long, global = true, value_name = "DIR")]
-    spec: Option<PathBuf>,
-    /// Output format.
-    #[arg(long, global = true, value_enum, default_value_t = Format::Text)]
-    format: Format,
     #[command(subcommand)]
     command: SpecCommand,
 }
@@ -69,29 +62,24 @@ enum SpecCommand {
 }
 
 /// Runs `drivespec spec …`.
-pub fn run(args: SpecArgs) -> Result<Outcome> {
-    let loaded = match &args.spec {
-        Some(dir) if !dir.is_dir() => {
-            bail!("cannot read spec folder {}: not a directory", dir.display())
-        }
-        Some(dir) => Spec::load_dir(dir),
-        None => Spec::builtin(),
-    };
+pub fn run(args: SpecArgs, ctx: &Context) -> Result<Outcome> {
+    let format = ctx.format;
     if let SpecCommand::Check = args.command {
-        return Ok(check(loaded, args.format));
+        let loaded = match &ctx.spec_dir {
+            Some(dir) if !dir.is_dir() => {
+                bail!("cannot read spec folder {}: not a directory", dir.display())
+            }
+            Some(dir) => Spec::load_dir(dir),
+            None => Spec::builtin(),
+        };
+        return Ok(check(loaded, format));
     }
-    let spec = loaded.map_err(|e| {
-        anyhow!(
-            "the spec is invalid ({} problems; run `drivespec spec check`): {}",
-            e.0.len(),
-            first_line(&e.to_string())
-        )
-    })?;
+    let spec = ctx.spec()?;
     let out = match &args.command {
         SpecCommand::List { device, model } => {
             let family = family(&spec, device)?;
             let model = model_arg(family, model.as_deref())?;
-            list(family, model, args.format)
+            list(family, model, format)
         }
         SpecCommand::Show {
             device,
@@ -107,14 +95,14 @@ pub fn run(args: SpecArgs) -> Result<Outcome> {
                     family.id()
                 )
             })?;
-            show(family, p, model, args.format)
+            show(family, p, model, format)
         }
-        SpecCommand::Models { device } => models(family(&spec, device)?, args.format),
+        SpecCommand::Models { device } => models(family(&spec, device)?, format),
         SpecCommand::Requirements { device, level } => {
-            requirements(family(&spec, device)?, level.as_deref(), args.format)
+            requirements(family(&spec, device)?, level.as_deref(), format)
         }
-        SpecCommand::Examples { device } => examples(family(&spec, device)?, args.format),
-        SpecCommand::Errata { device } => errata(family(&spec, device)?, args.format),
+        SpecCommand::Examples { device } => examples(family(&spec, device)?, format),
+        SpecCommand::Errata { device } => errata(family(&spec, device)?, format),
         SpecCommand::Check => unreachable_check(),
     }?;
     print!("{out}");
@@ -123,10 +111,6 @@ pub fn run(args: SpecArgs) -> Result<Outcome> {
 
 fn unreachable_check() -> Result<String> {
     bail!("spec check is handled before loading")
-}
-
-fn first_line(s: &str) -> &str {
-    s.lines().next().unwrap_or(s)
 }
 
 fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Outcome {
@@ -186,11 +170,6 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
     } else {
         Outcome::Fail
     }
-}
-
-fn json<T: Serialize>(v: &T) -> String {
-    serde_json::to_string_pretty(v)
-        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
 }
 
 fn family<'s>(spec: &'s Spec, device: &str) -> Result<&'s Family> {

@@ -6,6 +6,7 @@
 
 mod error;
 mod exchange;
+pub mod explain;
 mod line;
 pub mod memory;
 pub mod params;

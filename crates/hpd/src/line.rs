@@ -64,6 +64,21 @@ pub enum DiscardReason {
     Truncated,
 }
 
+impl std::fmt::Display for DiscardReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DiscardReason::Invalid(e) => write!(f, "{e}"),
+            DiscardReason::Timeout { timeout, elapsed } => {
+                write!(
+                    f,
+                    "not complete within the time-out of {timeout} µs ({elapsed} µs passed)"
+                )
+            }
+            DiscardReason::Truncated => f.write_str("the stream ends inside a message"),
+        }
+    }
+}
+
 /// Streaming decoder of a whole line.
 #[derive(Debug, Clone)]
 pub struct LineDecoder {

@@ -40,7 +40,8 @@ pub struct PlcRuntime {
     constant_result_discarded: bool,
     dword_param: [bool; 256],
     forbidden: [bool; 256],
-    constant: [bool; 256],
+    /// Values of the constants Pr71–Pr79 (3.8.1), which table 4.2 gives no address.
+    constant: [Option<i64>; 256],
     timers: Vec<(Slot, BitAddr)>,
     fin_slots: Vec<FinSlot>,
     fin_targets: Vec<u8>,
@@ -92,7 +93,14 @@ impl PlcRuntime {
             Some("nonzero") => ZeroFlag::SetWhenNonZero,
             _ => ZeroFlag::SetWhenZero,
         };
-        let constants: Vec<String> = plc.constants.iter().map(|c| c.param.clone()).collect();
+        let mut constant = [None; 256];
+        for c in &plc.constants {
+            if let Some(slot) =
+                ParamMap::parse_param(&c.param).and_then(|n| constant.get_mut(usize::from(n)))
+            {
+                *slot = Some(c.value);
+            }
+        }
         let mut timers = Vec::new();
         for t in &plc.timers {
             let n = ParamMap::parse_param(&t.param).ok_or(RulesError::Frame {
@@ -136,7 +144,7 @@ impl PlcRuntime {
             constant_result_discarded: a.constant_result_discarded,
             dword_param: numbers(&a.dword_params),
             forbidden: numbers(&a.forbidden_params),
-            constant: numbers(&constants),
+            constant,
             timers,
             fin_slots,
             fin_targets,
@@ -276,11 +284,15 @@ impl PlcRuntime {
     fn arith(&self, mem: &mut Memory, op: Operation, pa: u8, pb: u8, pc: u8) {
         let forced = mem.bit(self.dword_force);
         let is = |set: &[bool; 256], n: u8| set.get(usize::from(n)).copied().unwrap_or(false);
+        let constant = |n: u8| self.constant.get(usize::from(n)).copied().flatten();
         if [pa, pb, pc].iter().any(|n| is(&self.forbidden, *n)) {
             return;
         }
         let dword = |n: u8| forced || is(&self.dword_param, n);
         let read = |n: u8| -> Option<i64> {
+            if let Some(c) = constant(n) {
+                return Some(c);
+            }
             let s = self.map.slot(n)?;
             Some(i64::from(if dword(n) {
                 mem.get_signed(s.addr, 4)
@@ -288,8 +300,14 @@ impl PlcRuntime {
                 mem.get_signed(s.addr, 2)
             }))
         };
-        let (Some(a), Some(b), Some(out)) = (read(pa), read(pb), self.map.slot(pc)) else {
+        let (Some(a), Some(b)) = (read(pa), read(pb)) else {
             return;
+        };
+        // A result written to a constant only sets the flags (3.8.1).
+        let out = match (constant(pc), self.map.slot(pc)) {
+            (Some(_), _) if self.constant_result_discarded => None,
+            (_, Some(slot)) => Some(slot),
+            _ => return,
         };
         let wide = dword(pc);
         let (result, high) = match op {
@@ -297,30 +315,32 @@ impl PlcRuntime {
             Operation::Sub => (a.wrapping_sub(b), None),
             Operation::Mul => (a.wrapping_mul(b), None),
             Operation::Div if b == 0 => return,
-            Operation::Div if wide && self.div_remainder_high => (a / b, Some(a % b)),
-            Operation::Div => (a / b, None),
+            Operation::Div if wide && self.div_remainder_high => {
+                (a.wrapping_div(b), Some(a.wrapping_rem(b)))
+            }
+            Operation::Div => (a.wrapping_div(b), None),
             _ => return,
         };
         let stored = match (wide, high) {
             (true, Some(rem)) => {
                 let q = result as i16;
-                if !is(&self.constant, pc) || !self.constant_result_discarded {
-                    mem.set(out.addr, 2, q as u16 as u32);
-                    mem.set(out.addr.wrapping_add(2), 2, rem as i16 as u16 as u32);
+                if let Some(out) = out {
+                    mem.set(out.addr, 2, u32::from(q as u16));
+                    mem.set(out.addr.wrapping_add(2), 2, u32::from(rem as i16 as u16));
                 }
                 i64::from(q)
             }
             (true, None) => {
                 let v = result as i32;
-                if !is(&self.constant, pc) || !self.constant_result_discarded {
+                if let Some(out) = out {
                     mem.set(out.addr, 4, v as u32);
                 }
                 i64::from(v)
             }
             (false, _) => {
                 let v = result as i16;
-                if !is(&self.constant, pc) || !self.constant_result_discarded {
-                    mem.set(out.addr, 2, v as u16 as u32);
+                if let Some(out) = out {
+                    mem.set(out.addr, 2, u32::from(v as u16));
                 }
                 i64::from(v)
             }

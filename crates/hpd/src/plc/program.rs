@@ -13,21 +13,29 @@ pub struct Program {
 }
 
 /// Something in a program the drive ignores or refuses (manual 3.8.1).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ProgramIssue {
     /// A FIN after the first three instructions or after another instruction: a no-op.
+    #[error(
+        "FIN at {address:#04x} is ignored: FIN counts only as one of the first three instructions"
+    )]
     FinIgnored {
         /// Its address.
         address: usize,
     },
     /// An arithmetic operand that is a byte parameter.
+    #[error("arithmetic at {address:#04x} uses byte parameter {param}, which the PLC refuses")]
     ByteOperand {
         /// Address of the instruction.
         address: usize,
         /// The parameter (`Pr31`).
         param: String,
     },
+    /// The program does not end with END.
+    #[error("the program does not end with END")]
+    NoEnd,
     /// More instructions than the PLC holds.
+    #[error("{count} instructions (arithmetic counts twice), more than the {limit} the PLC holds")]
     TooManyInstructions {
         /// Instructions counted (arithmetic counts as two).
         count: usize,
@@ -164,6 +172,9 @@ impl PlcCodec {
                 }
                 _ => leading = false,
             }
+        }
+        if !program.instrs.last().is_some_and(|(_, i)| self.is_end(i)) {
+            issues.push(ProgramIssue::NoEnd);
         }
         let limit = usize::from(plc.max_instructions);
         if count > limit {
