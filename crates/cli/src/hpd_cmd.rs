@@ -54,7 +54,6 @@ struct FrameOut {
     bytes: String,
     #[serde(flatten)]
     message: Explained,
-    checksum_ok: bool,
 }
 
 #[derive(Serialize)]
@@ -96,16 +95,19 @@ pub fn decode(args: DecodeArgs, ctx: &Context) -> Result<Outcome> {
         let start = usize::try_from(offset).unwrap_or(usize::MAX);
         to_hex(bytes.get(start..start.saturating_add(len)).unwrap_or(&[]))
     };
+    let mut request = None;
     for event in events {
         match event {
             LineEvent::Frame(f) => {
                 pairer.push(f, &mut |x| out.exchanges.push(exchange_out(&x)));
-                let message = explain(family, &rules, plc.as_ref(), &f.message);
+                let message = explain(family, &rules, plc.as_ref(), &f.message, request.as_ref());
+                if f.message.is_request() {
+                    request = Some(f.message);
+                }
                 out.frames.push(FrameOut {
                     offset: f.offset,
                     bytes: slice(f.offset, f.len),
                     message,
-                    checksum_ok: true,
                 });
             }
             LineEvent::Discarded(d) => {
@@ -335,7 +337,13 @@ pub fn encode(args: EncodeArgs, ctx: &Context) -> Result<Outcome> {
                 bytes: String,
                 message: Explained,
             }
-            let message = explain(family, &rules, PlcCodec::from_spec(&spec).as_ref(), &msg);
+            let message = explain(
+                family,
+                &rules,
+                PlcCodec::from_spec(&spec).as_ref(),
+                &msg,
+                None,
+            );
             println!(
                 "{}",
                 json(&Out {

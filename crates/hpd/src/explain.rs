@@ -63,12 +63,14 @@ pub struct BitWrite {
     pub value: u8,
 }
 
-/// Describes `msg` with the HPD family's parameters and PLC instruction set.
+/// Describes `msg` with the HPD family's parameters and PLC instruction set; `request` is
+/// the request an answer follows, which tells whether its PAR is a PLC or parameter address.
 pub fn explain(
     family: &Family,
     rules: &FrameRules,
     plc: Option<&PlcCodec>,
     msg: &Message,
+    request: Option<&Message>,
 ) -> Explained {
     let kind = msg.kind();
     let type_name = kind.spec_name().to_owned();
@@ -101,6 +103,14 @@ pub fn explain(
             e.par = Some(par);
             e.summary = format!("read {lun} PLC byte(s) at {par:#04x} from drive {drive}");
         }
+        Message::Response { par, data, .. } if matches!(request, Some(Message::ReadPlc { .. })) => {
+            e.lun = Some(data.len());
+            e.par = Some(par);
+            e.data = Some(to_hex(data.as_slice()));
+            e.instructions = instructions(plc, par, &data);
+            let listing = listing(&e.instructions);
+            e.summary = format!("drive {drive} answers PLC bytes at {par:#04x}{listing}");
+        }
         Message::Response { par, data, .. }
         | Message::WriteParam { par, data, .. }
         | Message::Broadcast { par, data } => {
@@ -119,23 +129,8 @@ pub fn explain(
             e.lun = Some(data.len());
             e.par = Some(par);
             e.data = Some(to_hex(data.as_slice()));
-            if let Some(codec) = plc {
-                let mut at = 0;
-                while let Some(rest) = data.as_slice().get(at..).filter(|r| !r.is_empty()) {
-                    match codec.decode(rest, usize::from(par) + at) {
-                        Ok((instr, len)) => {
-                            e.instructions.push(codec.format(&instr));
-                            at += len;
-                        }
-                        Err(_) => break,
-                    }
-                }
-            }
-            let listing = if e.instructions.is_empty() {
-                String::new()
-            } else {
-                format!(": {}", e.instructions.join(", "))
-            };
+            e.instructions = instructions(plc, par, &data);
+            let listing = listing(&e.instructions);
             e.summary = format!("write PLC bytes at {par:#04x} on drive {drive}{listing}");
         }
         Message::BitChange {
@@ -179,6 +174,31 @@ pub fn explain(
         }
     }
     e
+}
+
+/// The PLC instructions in `data` written or read at PLC address `par` (whole ones only).
+fn instructions(plc: Option<&PlcCodec>, par: u8, data: &Data) -> Vec<String> {
+    let mut out = Vec::new();
+    let Some(codec) = plc else { return out };
+    let mut at = 0;
+    while let Some(rest) = data.as_slice().get(at..).filter(|r| !r.is_empty()) {
+        match codec.decode(rest, usize::from(par) + at) {
+            Ok((instr, len)) => {
+                out.push(codec.format(&instr));
+                at += len;
+            }
+            Err(_) => break,
+        }
+    }
+    out
+}
+
+fn listing(instructions: &[String]) -> String {
+    if instructions.is_empty() {
+        String::new()
+    } else {
+        format!(": {}", instructions.join(", "))
+    }
 }
 
 /// Fills parameter id and name for PAR/LUN; returns how to call it in a sentence.
