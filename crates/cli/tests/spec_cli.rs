@@ -74,7 +74,7 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
     copy_dir(std::path::Path::new(src), &dir);
     std::fs::write(
         dir.join("psd4xx/zz-broken.toml"),
-        "[[requirement]]\nid = \"PSD-X\"\nlevel = \"must\"\ntext = \"t\"\nsource = \"1\"\n\n[[requirement]]\nid = \"PSD-BROKEN-1\"\nlevel = \"maybe\"\ntext = \"t\"\nsource = \"1\"\n",
+        "[[requirement]]\nid = \"PSD-X\"\nlevel = \"must\"\ntext = \"t\"\nsource = \"1\"\n\n[[requirement]]\nid = \"PSD-FIXTURE-1\"\nlevel = \"maybe\"\ntext = \"t\"\nsource = \"1\"\n",
     )
     .unwrap();
     let r = drivespec(&["spec", "check", "--spec", dir.to_str().unwrap()]);
@@ -84,7 +84,7 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
     assert_eq!(lines.len(), 2, "{}", r.stdout);
     assert!(
         lines[0].starts_with(
-            "psd4xx/zz-broken.toml: requirement \"PSD-BROKEN-1\": unknown variant `maybe`"
+            "psd4xx/zz-broken.toml: requirement \"PSD-FIXTURE-1\": unknown variant `maybe`"
         ),
         "{}",
         lines[0]

@@ -9,6 +9,7 @@ mod exchange;
 pub mod explain;
 mod line;
 pub mod memory;
+pub mod model;
 pub mod params;
 pub mod plc;
 mod repr;

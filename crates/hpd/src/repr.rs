@@ -17,7 +17,9 @@ impl Data {
             return None;
         }
         let mut b = [0; 4];
-        b.get_mut(..bytes.len())?.copy_from_slice(bytes);
+        for (slot, v) in b.iter_mut().zip(bytes) {
+            *slot = *v;
+        }
         Some(Data {
             len: bytes.len() as u8,
             bytes: b,

@@ -89,6 +89,8 @@ pub struct FrameRules {
     pub bit_change_lun: u8,
     /// CMD code of each message kind, indexed by `MessageKind as usize`.
     codes: [u8; 7],
+    /// Message kind of each CMD code (CMD has at most 8 values: 3 bits).
+    kinds: [Option<MessageKind>; 8],
 }
 
 impl FrameRules {
@@ -152,6 +154,15 @@ impl FrameRules {
         bit_change_lun: u8,
         codes: [u8; 7],
     ) -> FrameRules {
+        let mut kinds = [None; 8];
+        for kind in MessageKind::ALL {
+            if let Some(slot) = codes
+                .get(kind.index())
+                .and_then(|c| kinds.get_mut(usize::from(*c)))
+            {
+                *slot = Some(kind);
+            }
+        }
         FrameRules {
             stx,
             stuff,
@@ -161,6 +172,7 @@ impl FrameRules {
             lun_max,
             bit_change_lun,
             codes,
+            kinds,
         }
     }
 
@@ -171,7 +183,7 @@ impl FrameRules {
 
     /// The message kind of a CMD code.
     pub fn kind(&self, cmd: u8) -> Option<MessageKind> {
-        MessageKind::ALL.into_iter().find(|k| self.code(*k) == cmd)
+        self.kinds.get(usize::from(cmd)).copied().flatten()
     }
 
     /// Splits CMD+ADDR into (CMD, ADDR).

@@ -61,6 +61,97 @@ pub fn decode(
     bytes: &[u8],
     ack: AckEnd,
 ) -> Result<Status<Decoded>, DecodeError> {
+    if let Some(d) = decode_plain(rules, bytes) {
+        return Ok(Status::Complete(d));
+    }
+    decode_general(rules, bytes, ack)
+}
+
+/// The common case in one pass: a complete, valid message with no stuffed byte inside.
+/// Returns `None` for anything else, which the general decoder then handles (so both paths
+/// always agree on valid input).
+fn decode_plain(rules: &FrameRules, bytes: &[u8]) -> Option<Decoded> {
+    let stx = rules.stx;
+    let (&first, rest) = bytes.split_first()?;
+    let (&cmd_addr, _) = rest.split_first()?;
+    if first != stx || cmd_addr == stx || cmd_addr == 0 {
+        return None;
+    }
+    let (cmd, addr) = rules.split(cmd_addr);
+    let kind = rules.kind(cmd)?;
+    let lun = *bytes.get(2)?;
+    if kind == MessageKind::Response && lun == stx {
+        return Some(Decoded {
+            message: Message::Ack { addr },
+            len: 2,
+        });
+    }
+    if !(rules.lun_min..=rules.lun_max).contains(&lun)
+        || (kind == MessageKind::Broadcast && addr != 0)
+        || (kind == MessageKind::BitChange && lun != rules.bit_change_lun)
+    {
+        return None;
+    }
+    let data_len = match kind {
+        MessageKind::ReadPlc | MessageKind::ReadParam => 0,
+        _ => usize::from(lun),
+    };
+    let len = 5 + data_len;
+    let frame = bytes.get(..len)?;
+    let (&chk, fields) = frame.get(1..)?.split_last()?;
+    let mut sum = 0u8;
+    for &b in fields {
+        if b == stx {
+            return None;
+        }
+        sum = sum.wrapping_add(b);
+    }
+    if chk == stx || (sum != chk && !cfg!(fuzzing)) {
+        return None;
+    }
+    let par = *frame.get(3)?;
+    let data = frame.get(4..4 + data_len)?;
+    let message = match kind {
+        MessageKind::ReadPlc => Message::ReadPlc { addr, lun, par },
+        MessageKind::ReadParam => Message::ReadParam { addr, lun, par },
+        MessageKind::Response => Message::Response {
+            addr,
+            par,
+            data: Data::new(data)?,
+        },
+        MessageKind::WritePlc => Message::WritePlc {
+            addr,
+            par,
+            data: Data::new(data)?,
+        },
+        MessageKind::WriteParam => Message::WriteParam {
+            addr,
+            par,
+            data: Data::new(data)?,
+        },
+        MessageKind::Broadcast => Message::Broadcast {
+            par,
+            data: Data::new(data)?,
+        },
+        MessageKind::BitChange => match data {
+            [mask, value] => Message::BitChange {
+                addr,
+                par,
+                mask: *mask,
+                value: *value,
+            },
+            _ => return None,
+        },
+    };
+    Some(Decoded { message, len })
+}
+
+/// Field-by-field decoding with stuffing, partial input and every error.
+fn decode_general(
+    rules: &FrameRules,
+    bytes: &[u8],
+    ack: AckEnd,
+) -> Result<Status<Decoded>, DecodeError> {
     let mut cur = Cursor {
         rules,
         bytes,

@@ -1017,7 +1017,9 @@ mod tests {
 
     fn protocol() -> Result<Protocol, String> {
         let text = include_str!("../../../spec/psd4xx/protocol.toml");
-        toml::from_str::<File>(text).map(|f| f.protocol).map_err(|e| e.to_string())
+        toml::from_str::<File>(text)
+            .map(|f| f.protocol)
+            .map_err(|e| e.to_string())
     }
 
     fn contiguous(fields: &[Field], length: usize) -> bool {
@@ -1034,10 +1036,23 @@ mod tests {
     #[test]
     fn layouts_are_contiguous() -> Result<(), String> {
         let p = protocol()?;
-        assert!(contiguous(&p.process_data.output.fields, p.process_data.output.length));
-        assert!(contiguous(&p.process_data.input.fields, p.process_data.input.length));
+        assert!(contiguous(
+            &p.process_data.output.fields,
+            p.process_data.output.length
+        ));
+        assert!(contiguous(
+            &p.process_data.input.fields,
+            p.process_data.input.length
+        ));
         assert!(contiguous(&p.pkw.fields, p.pkw.length));
-        assert_eq!((p.process_data.output.length, p.process_data.input.length, p.pkw.length), (14, 16, 8));
+        assert_eq!(
+            (
+                p.process_data.output.length,
+                p.process_data.input.length,
+                p.pkw.length
+            ),
+            (14, 16, 8)
+        );
         let control = p.process_data.output.field("control").ok_or("control")?;
         assert_eq!(control.byte_order(p.byte_order), ByteOrder::LittleEndian);
         Ok(())
@@ -1049,7 +1064,10 @@ mod tests {
         let ak = p.pkw.pke_bit("ak").ok_or("ak")?;
         let pnu = p.pkw.pke_bit("pnu").ok_or("pnu")?;
         let spm = p.pkw.pke_bit("spm").ok_or("spm")?;
-        assert_eq!((ak.get(0x102C), pnu.get(0x102C), spm.get(0x102C)), (1, 44, 0));
+        assert_eq!(
+            (ak.get(0x102C), pnu.get(0x102C), spm.get(0x102C)),
+            (1, 44, 0)
+        );
         assert_eq!(pnu.put(ak.put(0, 7), 44), 0x702C);
         let total: u32 = p.pkw.pke_bits.iter().map(|b| b.width).sum();
         assert_eq!(total, 16);
@@ -1061,13 +1079,20 @@ mod tests {
         let p = protocol()?;
         for c in &p.pkw.commands {
             for r in c.positive.iter().chain(&c.negative) {
-                assert!(p.pkw.response(*r).is_some(), "command {} names response {r}", c.code);
+                assert!(
+                    p.pkw.response(*r).is_some(),
+                    "command {} names response {r}",
+                    c.code
+                );
             }
         }
         for code in &p.pkw.echo.commands {
             assert_eq!(p.pkw.command(*code).map(|c| c.op), Some(PkwOp::Write));
         }
-        assert_eq!(p.pkw.response_with(PkwValue::Error).map(|r| r.code), Some(7));
+        assert_eq!(
+            p.pkw.response_with(PkwValue::Error).map(|r| r.code),
+            Some(7)
+        );
         assert_eq!(p.pkw.error_named("out-of-range").map(|e| e.code), Some(2));
         for l in &p.record.lengths {
             assert_eq!(l.write, l.read + p.record.control_byte_length);
@@ -1085,14 +1110,20 @@ mod tests {
         assert_eq!(m.lower_offset, m.lower_offset_rotations * base);
         assert_eq!(m.span, m.encoder_rotations * base);
         assert_eq!(m.span, m.lower_offset - m.upper_margin);
-        assert_eq!(m.position_range(m.default_mapping_end), (m.default_lower_limit, m.default_upper_limit));
+        assert_eq!(
+            m.position_range(m.default_mapping_end),
+            (m.default_lower_limit, m.default_upper_limit)
+        );
         assert_eq!(m.default_upper_limit, m.default_range_rotations * base);
         assert_eq!(m.mapping_end_window(0), (1200, 1_611_600));
         let s = &p.positioning.scaling;
         assert_eq!(s.increments_per_rotation(400, 100), Some(100.0));
         assert_eq!(s.scale(m.lower_offset, 400, 100), Some(402_900));
         let l = &p.positioning.reference_loop;
-        assert_eq!(l.default_length * l.default_length_rotations[1], base * l.default_length_rotations[0]);
+        assert_eq!(
+            l.default_length * l.default_length_rotations[1],
+            base * l.default_length_rotations[0]
+        );
         assert_eq!(l.approach(250), Some(Direction::Increasing));
         assert_eq!(l.approach(-250), Some(Direction::Decreasing));
         assert_eq!(l.approach(0), None);

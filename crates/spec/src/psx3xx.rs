@@ -1020,7 +1020,10 @@ mod tests {
         assert_eq!(p.device_id_for(31208, 1), Some(3_120_802));
         assert_eq!(p.device_id_for(31208, 2), Some(3_120_804));
         assert_eq!(p.timestamp.delay_us(10_000), Some(40_000));
-        assert_eq!(p.timestamp.delay_us(p.timestamp.max_valid), Some(p.timestamp.max_delay_us));
+        assert_eq!(
+            p.timestamp.delay_us(p.timestamp.max_valid),
+            Some(p.timestamp.max_delay_us)
+        );
         assert_eq!(p.timestamp.delay_us(p.timestamp.inactive), None);
         assert!(p.timestamp.immediate(1999));
         assert!(!p.timestamp.immediate(2000));
@@ -1029,15 +1032,31 @@ mod tests {
             .filter_map(|f| p.output_format(*f).map(|i| i.length))
             .collect();
         assert_eq!(lengths, vec![2, 6, 8]);
-        for image in p.process_outputs.iter().chain(std::iter::once(&p.process_input)) {
+        for image in p
+            .process_outputs
+            .iter()
+            .chain(std::iter::once(&p.process_input))
+        {
             for f in &image.fields {
-                assert!(f.offset + f.length <= image.length, "{} {}", image.name, f.name);
+                assert!(
+                    f.offset + f.length <= image.length,
+                    "{} {}",
+                    image.name,
+                    f.name
+                );
                 assert!(f.bit + f.bits <= f.length * 8, "{} {}", image.name, f.name);
             }
         }
         let min_cycle = p.direct_parameter(2).and_then(|e| e.delivery);
         assert_eq!(min_cycle, Some(0x44));
-        let base = p.direct_parameters.cycle_time_bases.iter().find(|b| b.code == 1);
-        assert_eq!(base.map(|b| b.offset_us + 4 * b.step_us), Some(p.constants.min_cycle_time_us));
+        let base = p
+            .direct_parameters
+            .cycle_time_bases
+            .iter()
+            .find(|b| b.code == 1);
+        assert_eq!(
+            base.map(|b| b.offset_us + 4 * b.step_us),
+            Some(p.constants.min_cycle_time_us)
+        );
     }
 }

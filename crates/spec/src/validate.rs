@@ -441,6 +441,19 @@ impl Validator<'_> {
                     self.dangling(&v.file, rec.clone(), "model", m);
                 }
             }
+            for key in v.kind.required_input() {
+                if !v.input.contains_key(*key) {
+                    let message = format!("a {} vector needs input key `{key}`", v.kind.as_str());
+                    self.push(&v.file, rec.clone(), ProblemKind::Invalid { message });
+                }
+            }
+            if v.kind == crate::VectorKind::Sequence
+                && !v.input.contains_key("steps")
+                && !v.expect.contains_key("rows")
+            {
+                let message = "a sequence vector needs input `steps` or expect `rows`".to_owned();
+                self.push(&v.file, rec.clone(), ProblemKind::Invalid { message });
+            }
         }
     }
 }

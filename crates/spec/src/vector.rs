@@ -33,6 +33,22 @@ pub enum VectorKind {
 }
 
 impl VectorKind {
+    /// Keys `input` must have for a vector of this kind to mean anything.
+    pub fn required_input(self) -> &'static [&'static str] {
+        match self {
+            VectorKind::HpdFrame => &["request"],
+            VectorKind::HpdPlc => &["program"],
+            VectorKind::HpdPlcBytes => &["listing"],
+            VectorKind::Formula => &["formula"],
+            VectorKind::Pkw => &["ak", "pnu"],
+            VectorKind::ProcessImage => &["direction"],
+            VectorKind::Record | VectorKind::Isdu => &["op", "index"],
+            VectorKind::Timestamp => &["stamp"],
+            VectorKind::Position | VectorKind::Sequence => &[],
+            VectorKind::DirectParameter => &["bytes"],
+        }
+    }
+
     /// The name used in spec files.
     pub fn as_str(self) -> &'static str {
         match self {

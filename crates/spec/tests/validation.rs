@@ -486,3 +486,27 @@ fn every_problem_is_reported_not_just_the_first() {
     );
     assert_eq!(problems_with("psd4xx/test.toml", &bad).len(), 2);
 }
+
+#[test]
+fn vector_needs_its_kinds_input_keys() {
+    let mut files = skeleton();
+    files.set("psd4xx/test.toml", REQ);
+    files.set(
+        "psd4xx/vectors/test.toml",
+        &VECTOR.replace(
+            "ak = 1\npnu = 44\n[vector.expect]",
+            "pnu = 44\n[vector.expect]",
+        ),
+    );
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(
+        problems,
+        vec![
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": a pkw vector needs input key `ak`"#
+                .to_owned()
+        ]
+    );
+}

@@ -1,0 +1,44 @@
+//! Names of the bits and parameters the model acts on that the spec's protocol tables do not
+//! name, and the erratum options it follows. Addresses and masks still come from the spec's
+//! parameter table; only the names are written here.
+
+/// Alarm reset command (manual 3.4 b99.10).
+pub(super) const ALARM_RESET: &str = "b99.10";
+/// Operating-mode defaults command (manual 3.4 b99.11).
+pub(super) const MODE_DEFAULTS: &str = "b99.11";
+/// Security (manual 3.3 b99.7).
+pub(super) const SECURITY: &str = "b99.7";
+/// Extended menu, needed by b42.3 (manual 3.3 b99.6, 3.4).
+pub(super) const EXTENDED_MENU: &str = "b99.6";
+/// Reserved reference select, must be 0 for b99.11 (manual 3.3 b40.2, 3.4).
+pub(super) const RESERVED_REFERENCE: &str = "b40.2";
+/// Active alarm (manual 3.3 Pr23).
+pub(super) const ALARM_CODE: &str = "Pr23";
+/// Last alarm (manual 3.3 Pr24).
+pub(super) const LAST_ALARM: &str = "Pr24";
+/// Operating mode (manual 3.3 Pr31, 3.6).
+pub(super) const OPERATING_MODE: &str = "Pr31";
+
+/// Bit-rule trigger of command bits the drive executes (bits.toml).
+pub(super) const TRIGGER_COMMAND: &str = "command-executed";
+/// Bit-rule trigger of bits cleared at power-up (bits.toml).
+pub(super) const TRIGGER_POWER_ON: &str = "power-on";
+/// Bit-rule trigger that clears the drive-healthy bit (bits.toml, b41.4).
+pub(super) const TRIGGER_ALARM_RAISED: &str = "alarm-raised";
+
+/// Erratum option: do command bits clear themselves (HPD-ERRATUM-012).
+pub(super) const OPTION_SELF_CLEAR: &str = "command-self-clear";
+/// Reading of `OPTION_SELF_CLEAR` where command bits stay 1.
+pub(super) const READING_LATCHED: &str = "latched";
+/// Erratum option: is b99.14 refused on checksum alarms (HPD-ERRATUM-013).
+pub(super) const OPTION_PLC_SAVE: &str = "b99-14-checksum";
+/// Reading of `OPTION_PLC_SAVE` where b99.14 is refused like b99.15.
+pub(super) const READING_BOTH: &str = "both";
+/// Erratum option: does security b99.7 cover serial writes (HPD-ERRATUM-011).
+pub(super) const OPTION_SECURITY: &str = "b99-7-scope";
+/// Reading of `OPTION_SECURITY` where only the keypad is locked.
+pub(super) const READING_KEYPAD_ONLY: &str = "keypad-only";
+/// Erratum option: the range of Pr31 (HPD-ERRATUM-014).
+pub(super) const OPTION_MODE_RANGE: &str = "pr31-range";
+/// Reading of `OPTION_MODE_RANGE` where any byte is accepted.
+pub(super) const READING_ANY_BYTE: &str = "byte";

@@ -1,0 +1,4 @@
+//! cargo-fuzz target `hpd_plc`: see `drivespec_fuzz::hpd::plc`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::hpd::plc(data));

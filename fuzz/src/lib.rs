@@ -1,0 +1,25 @@
+//! The logic of every fuzz target, as plain functions over bytes.
+//!
+//! The cargo-fuzz targets in `fuzz_targets/` call these; `tests/replay.rs` runs them on every
+//! file under `corpus/<target>/` so plain `cargo test` on stable replays the corpora and the
+//! crashes kept as regression files. Each function panics only when an invariant breaks:
+//! that is the finding.
+#![allow(
+    clippy::panic,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing
+)]
+
+pub mod hpd;
+
+/// A fuzz target: its name and the function it runs on each input.
+pub type Target = (&'static str, fn(&[u8]));
+
+/// Every fuzz target by name, with its function.
+pub const TARGETS: &[Target] = &[
+    ("hpd_frame", hpd::frame),
+    ("hpd_line", hpd::line),
+    ("hpd_plc", hpd::plc),
+    ("hpd_roundtrip", hpd::roundtrip),
+];
