@@ -415,6 +415,8 @@ enum PlcWhat {
         /// Program bytes in hex.
         hex: Vec<String>,
     },
+    /// The default program (appendix G) with what it reads and drives.
+    Default,
 }
 
 #[derive(Serialize)]
@@ -422,6 +424,16 @@ struct ProgramOut {
     bytes: String,
     instructions: Vec<InstrOut>,
     issues: Vec<String>,
+    reads: Vec<Named>,
+    writes: Vec<Named>,
+}
+
+/// A bit or word with its name from the spec.
+#[derive(Serialize)]
+struct Named {
+    id: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    name: Option<String>,
 }
 
 #[derive(Serialize)]
@@ -429,12 +441,15 @@ struct InstrOut {
     address: usize,
     listing: String,
     bytes: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    comment: Option<String>,
 }
 
 /// Runs `drivespec plc hpd`.
 pub fn plc(args: PlcArgs, ctx: &Context) -> Result<Outcome> {
     let spec = ctx.spec()?;
     let codec = PlcCodec::from_spec(&spec).ok_or_else(|| anyhow!("the spec has no PLC table"))?;
+    let is_default = matches!(args.what, PlcWhat::Default);
     let (program, bytes) = match args.what {
         PlcWhat::Asm { file } => {
             let text = if file.as_os_str() == "-" {
@@ -456,15 +471,57 @@ pub fn plc(args: PlcArgs, ctx: &Context) -> Result<Outcome> {
             let bytes = parse_hex(&hex.join(" ")).map_err(|e| anyhow!("bad hex: {e}"))?;
             (codec.decode_program(&bytes)?, bytes)
         }
+        PlcWhat::Default => {
+            let g = &spec
+                .family(FamilyId::Hpd)
+                .hpd()
+                .ok_or_else(|| anyhow!("the spec has no HPD protocol table"))?
+                .default_program;
+            let listing: String = g.iter().map(|l| format!("{}\n", l.listing)).collect();
+            let program = codec.parse_listing(&listing)?;
+            let bytes = codec.encode_program(&program)?;
+            (program, bytes)
+        }
     };
-    let out = program_out(&codec, &program, &bytes);
+    let comments = match spec.family(FamilyId::Hpd).hpd() {
+        Some(p) if is_default => p
+            .default_program
+            .iter()
+            .map(|l| (usize::from(l.address), l.comment.clone()))
+            .collect(),
+        _ => Vec::new(),
+    };
+    let mut out = program_out(&codec, &program, &bytes, spec.family(FamilyId::Hpd));
+    for i in &mut out.instructions {
+        i.comment = comments
+            .iter()
+            .find(|(a, _)| *a == i.address)
+            .and_then(|(_, c)| c.clone());
+    }
     match ctx.format {
         Format::Json => println!("{}", json(&out)),
         Format::Text => {
             for i in &out.instructions {
-                println!("{:02X}: {:<14} ; {}", i.address, i.listing, i.bytes);
+                match &i.comment {
+                    Some(c) => println!(
+                        "{:02X}: {:<14} ; {:<11} ; {c}",
+                        i.address, i.listing, i.bytes
+                    ),
+                    None => println!("{:02X}: {:<14} ; {}", i.address, i.listing, i.bytes),
+                }
             }
             println!("{} bytes: {}", bytes.len(), out.bytes);
+            let names = |list: &[Named]| -> String {
+                list.iter()
+                    .map(|n| match &n.name {
+                        Some(name) => format!("{} ({name})", n.id),
+                        None => n.id.clone(),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            println!("reads:  {}", names(&out.reads));
+            println!("drives: {}", names(&out.writes));
             for issue in &out.issues {
                 println!("warning: {issue}");
             }
@@ -477,7 +534,7 @@ pub fn plc(args: PlcArgs, ctx: &Context) -> Result<Outcome> {
     })
 }
 
-fn program_out(codec: &PlcCodec, program: &Program, bytes: &[u8]) -> ProgramOut {
+fn program_out(codec: &PlcCodec, program: &Program, bytes: &[u8], family: &Family) -> ProgramOut {
     let instructions = program
         .instrs
         .iter()
@@ -487,6 +544,7 @@ fn program_out(codec: &PlcCodec, program: &Program, bytes: &[u8]) -> ProgramOut 
                 address: *address,
                 listing: codec.format(instr),
                 bytes: to_hex(bytes.get(*address..address + len).unwrap_or(&[])),
+                comment: None,
             }
         })
         .collect();
@@ -495,9 +553,35 @@ fn program_out(codec: &PlcCodec, program: &Program, bytes: &[u8]) -> ProgramOut 
         .iter()
         .map(ToString::to_string)
         .collect();
+    let fx = codec.effects(program);
+    let named = |ids: Vec<String>| {
+        ids.into_iter()
+            .map(|id| Named {
+                name: name_of(family, &id),
+                id,
+            })
+            .collect()
+    };
     ProgramOut {
         bytes: to_hex(bytes),
         instructions,
         issues,
+        reads: named(fx.reads),
+        writes: named(fx.writes),
+    }
+}
+
+/// The spec's name of `b40.4` (the bit's name) or `Pr5` (the parameter's name).
+fn name_of(family: &Family, id: &str) -> Option<String> {
+    match id.strip_prefix('b').and_then(|r| r.split_once('.')) {
+        Some((n, y)) => {
+            let p = family.parameter(n)?;
+            let bit: u32 = y.parse().ok()?;
+            family
+                .bitfields_of(&p.id)
+                .find_map(|b| b.bit(bit))
+                .map(|b| b.name.clone())
+        }
+        None => family.parameter(id).map(|p| p.name.clone()),
     }
 }

@@ -9,4 +9,4 @@ mod program;
 pub use codec::{Instr, Operands, PlcCodec, PlcError};
 pub use interp::{PlcRuntime, PlcState, ZeroFlag};
 pub use listing::ListingError;
-pub use program::{Program, ProgramIssue};
+pub use program::{Effects, Program, ProgramIssue};

@@ -183,3 +183,65 @@ impl PlcCodec {
         issues
     }
 }
+
+/// What a program reads and writes (manual 3.8.1): bits as `bNN.y`, words as `PrN`, in
+/// program order without repeats.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Effects {
+    /// Bits and words the program reads.
+    pub reads: Vec<String>,
+    /// Bits and words the program writes.
+    pub writes: Vec<String>,
+}
+
+impl PlcCodec {
+    /// The bits and words `program` reads and writes.
+    pub fn effects(&self, program: &Program) -> Effects {
+        let mut fx = Effects::default();
+        let add = |list: &mut Vec<String>, item: String| {
+            if !list.contains(&item) {
+                list.push(item);
+            }
+        };
+        let ignored: Vec<usize> = self
+            .check(program)
+            .iter()
+            .filter_map(|i| match i {
+                ProgramIssue::FinIgnored { address } => Some(*address),
+                _ => None,
+            })
+            .collect();
+        for (address, instr) in &program.instrs {
+            let Some(spec) = self.plc().instruction(instr.code) else {
+                continue;
+            };
+            if ignored.contains(address) {
+                continue;
+            }
+            match instr.operands {
+                Operands::Bit { pa, y } => {
+                    let bit = format!("b{pa}.{y}");
+                    match spec.operation {
+                        Operation::Out | Operation::Set | Operation::Reset => {
+                            add(&mut fx.writes, bit)
+                        }
+                        _ => add(&mut fx.reads, bit),
+                    }
+                }
+                Operands::Arith { pa, pb, pc, .. } => {
+                    add(&mut fx.reads, format!("Pr{pa}"));
+                    add(&mut fx.reads, format!("Pr{pb}"));
+                    add(&mut fx.writes, format!("Pr{pc}"));
+                }
+                Operands::Fin { y, n, .. } => {
+                    if let Some(target) = self.plc().fast_inputs.targets.get(usize::from(n & 1)) {
+                        let number = target.trim_start_matches(|c: char| c.is_ascii_alphabetic());
+                        add(&mut fx.writes, format!("b{number}.{y}"));
+                    }
+                }
+                Operands::None { .. } => {}
+            }
+        }
+        fx
+    }
+}
