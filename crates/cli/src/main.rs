@@ -1,6 +1,7 @@
 //! `drivespec`: the command-line front end. Parsing and printing only; the work is in the libraries.
 
 mod hpd_cmd;
+mod pd_cmd;
 mod spec_cmd;
 
 use anyhow::{anyhow, bail, Result};
@@ -48,12 +49,20 @@ enum Command {
 enum DecodeDevice {
     /// HPD serial messages (manual 4.1).
     Hpd(hpd_cmd::DecodeArgs),
+    /// PSD4xx PROFINET process images with the PKW channel (bus description 3.5, 3.8).
+    Psd4xx(pd_cmd::Psd4xxDecode),
+    /// PSx3xx IO-Link process images (instruction manual 3.3).
+    Psx3xx(pd_cmd::Psx3xxDecode),
 }
 
 #[derive(Subcommand)]
 enum EncodeDevice {
     /// HPD serial messages (manual 4.1).
     Hpd(hpd_cmd::EncodeArgs),
+    /// PSD4xx PROFINET process images (bus description 3.5, 3.8).
+    Psd4xx(pd_cmd::Psd4xxEncode),
+    /// PSx3xx IO-Link process images (instruction manual 3.3).
+    Psx3xx(pd_cmd::Psx3xxEncode),
 }
 
 #[derive(Subcommand)]
@@ -132,12 +141,16 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Spec(args) => spec_cmd::run(args, &ctx),
-        Command::Decode {
-            device: DecodeDevice::Hpd(args),
-        } => hpd_cmd::decode(args, &ctx),
-        Command::Encode {
-            device: EncodeDevice::Hpd(args),
-        } => hpd_cmd::encode(args, &ctx),
+        Command::Decode { device } => match device {
+            DecodeDevice::Hpd(args) => hpd_cmd::decode(args, &ctx),
+            DecodeDevice::Psd4xx(args) => pd_cmd::decode_psd4xx(args, &ctx),
+            DecodeDevice::Psx3xx(args) => pd_cmd::decode_psx3xx(args, &ctx),
+        },
+        Command::Encode { device } => match device {
+            EncodeDevice::Hpd(args) => hpd_cmd::encode(args, &ctx),
+            EncodeDevice::Psd4xx(args) => pd_cmd::encode_psd4xx(args, &ctx),
+            EncodeDevice::Psx3xx(args) => pd_cmd::encode_psx3xx(args, &ctx),
+        },
         Command::Plc {
             device: PlcDevice::Hpd(args),
         } => hpd_cmd::plc(args, &ctx),
