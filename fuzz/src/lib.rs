@@ -12,6 +12,7 @@
 )]
 
 pub mod hpd;
+pub mod pd;
 
 /// A fuzz target: its name and the function it runs on each input.
 pub type Target = (&'static str, fn(&[u8]));
@@ -22,4 +23,10 @@ pub const TARGETS: &[Target] = &[
     ("hpd_line", hpd::line),
     ("hpd_plc", hpd::plc),
     ("hpd_roundtrip", hpd::roundtrip),
+    ("psd4xx_image", pd::psd4xx_image),
+    ("psd4xx_pkw", pd::psd4xx_pkw),
+    ("psd4xx_record", pd::psd4xx_record),
+    ("psx3xx_image", pd::psx3xx_image),
+    ("psx3xx_isdu", pd::psx3xx_isdu),
+    ("psx3xx_direct", pd::psx3xx_direct),
 ];
