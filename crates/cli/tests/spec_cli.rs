@@ -129,3 +129,97 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
         }
     }
 }
+
+/// `spec show` for a few parameters per device, as people read them.
+#[test]
+fn spec_show_snapshots() {
+    let cases: [&[&str]; 9] = [
+        &["spec", "show", "psd4xx", "63", "--model", "PSD426"],
+        &["spec", "show", "psd4xx", "63"],
+        &["spec", "show", "psd4xx", "1"],
+        &["spec", "show", "psd4xx", "96"],
+        &["spec", "show", "hpd", "Pr64"],
+        &["spec", "show", "hpd", "Pr33"],
+        &["spec", "show", "hpd", "Pb99"],
+        &["spec", "show", "psx3xx", "193"],
+        &["spec", "show", "psx3xx", "64"],
+    ];
+    for args in cases {
+        let r = drivespec(args);
+        assert_eq!(r.code, 0, "{args:?}: {}", r.stderr);
+        insta::assert_snapshot!(args[2..].join("_").replace(' ', "_"), r.stdout);
+    }
+}
+
+#[test]
+fn spec_show_json_is_the_record_plus_the_resolution() {
+    let r = drivespec(&[
+        "spec",
+        "show",
+        "psd4xx",
+        "63",
+        "--model",
+        "psd 426/436-14h",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(r.code, 0);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(v["model"], "PSD426-14H");
+    assert_eq!(v["resolved"]["range"], serde_json::json!([[150, 720]]));
+    assert_eq!(v["resolved"]["default"], 360);
+    assert_eq!(v["parameter"]["id"], "63");
+    assert_eq!(v["per_model"].as_array().map(Vec::len), Some(11));
+}
+
+#[test]
+fn unknown_model_lists_the_known_ones() {
+    let r = drivespec(&["spec", "show", "psd4xx", "63", "--model", "PSD999"]);
+    assert_eq!(r.code, 2);
+    assert!(
+        r.stderr
+            .starts_with("drivespec: unknown psd4xx model \"PSD999\"; known models: PSD401-5V, "),
+        "{}",
+        r.stderr
+    );
+}
+
+#[test]
+fn models_match_forgivingly() {
+    for (family, query, want) in [
+        ("psd4xx", "PSD426", "PSD426-14H"),
+        ("psd4xx", "psd 426/436-14h", "PSD426-14H"),
+        ("psx3xx", "PSE335-14", "PSE335-14"),
+        ("psx3xx", "pse 335-14", "PSE335-14"),
+    ] {
+        let r = drivespec(&["spec", "list", family, "--model", query, "--format", "json"]);
+        assert_eq!(r.code, 0, "{query}: {}", r.stderr);
+        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        assert_eq!(v["model"], want, "{query}");
+    }
+}
+
+#[test]
+fn models_and_errata_listings() {
+    let r = drivespec(&["spec", "models", "psd4xx"]);
+    assert_eq!(r.code, 0);
+    insta::assert_snapshot!("models_psd4xx", r.stdout);
+    let r = drivespec(&["spec", "errata", "hpd"]);
+    assert_eq!(r.code, 0);
+    assert!(r.stdout.contains("HPD-ERRATUM-001: b99.3"), "{}", r.stdout);
+    let r = drivespec(&[
+        "spec",
+        "requirements",
+        "psd4xx",
+        "--level",
+        "must",
+        "--format",
+        "json",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert!(v["requirements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|r| r["level"] == "must"));
+}
