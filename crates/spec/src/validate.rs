@@ -441,6 +441,11 @@ impl Validator<'_> {
                     self.dangling(&v.file, rec.clone(), "model", m);
                 }
             }
+            for name in vector_params(&v.input).chain(vector_params(&v.expect)) {
+                if f.parameter(&name).is_none() {
+                    self.dangling(&v.file, rec.clone(), "parameter", &name);
+                }
+            }
             for key in v.kind.required_input() {
                 if !v.input.contains_key(*key) {
                     let message = format!("a {} vector needs input key `{key}`", v.kind.as_str());
@@ -456,6 +461,41 @@ impl Validator<'_> {
             }
         }
     }
+}
+
+/// Parameters a vector names: the value of `param`, the keys of `params` (`Pr64`), of `bits`
+/// (`b99.14` names Pb99/Pr99) and of `dwords` (`Pr64:65` names Pr64 and Pr65).
+fn vector_params(table: &toml::Table) -> impl Iterator<Item = String> + '_ {
+    let param = table
+        .get("param")
+        .and_then(toml::Value::as_str)
+        .map(str::to_owned);
+    let keys = |key: &'static str| {
+        table
+            .get(key)
+            .and_then(toml::Value::as_table)
+            .into_iter()
+            .flat_map(|t| t.keys())
+    };
+    let params = keys("params").map(|k| k.to_owned());
+    let bits = keys("bits").filter_map(|k| {
+        k.strip_prefix('b')?
+            .split_once('.')
+            .map(|(n, _)| n.to_owned())
+    });
+    let dwords = keys("dwords").flat_map(|k| {
+        let (lo, hi) = k.split_once(':').unwrap_or((k, ""));
+        let prefix: String = lo.chars().take_while(|c| c.is_ascii_alphabetic()).collect();
+        [
+            Some(lo.to_owned()),
+            (!hi.is_empty()).then(|| format!("{prefix}{hi}")),
+        ]
+    });
+    param
+        .into_iter()
+        .chain(params)
+        .chain(bits)
+        .chain(dwords.flatten())
 }
 
 fn rec_p(p: &Parameter) -> String {

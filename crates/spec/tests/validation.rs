@@ -510,3 +510,29 @@ fn vector_needs_its_kinds_input_keys() {
         ]
     );
 }
+
+#[test]
+fn vector_parameters_must_exist() {
+    let mut files = skeleton();
+    files.set("psd4xx/test.toml", &format!("{PARAM}{REQ}"));
+    let v = VECTOR
+        .replace("pnu = 44\n", "pnu = 44\nparam = \"45\"\n")
+        .replace(
+            "pwe = 2\n",
+            "pwe = 2\nparams = { \"44\" = 2, \"46\" = 1 }\n",
+        );
+    files.set("psd4xx/vectors/test.toml", &v);
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(
+        problems,
+        vec![
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": parameter "45" does not exist"#
+                .to_owned(),
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": parameter "46" does not exist"#
+                .to_owned(),
+        ]
+    );
+}
