@@ -23,6 +23,7 @@ pub const TARGETS: &[Target] = &[
     ("hpd_line", hpd::line),
     ("hpd_plc", hpd::plc),
     ("hpd_roundtrip", hpd::roundtrip),
+    ("hpd_model", hpd::model),
     ("psd4xx_image", pd::psd4xx_image),
     ("psd4xx_pkw", pd::psd4xx_pkw),
     ("psd4xx_record", pd::psd4xx_record),

@@ -50,7 +50,9 @@ pub fn psd4xx_pkw(data: &[u8]) {
 
 /// PSD4xx records: the first two bytes pick the index; a parsed record re-encodes exactly.
 pub fn psd4xx_record(data: &[u8]) {
-    let Some((index, body)) = data.split_first_chunk::<2>() else { return };
+    let Some((index, body)) = data.split_first_chunk::<2>() else {
+        return;
+    };
     let index = u16::from_be_bytes(*index) % 128;
     let rules = psd().record();
     if let Ok(w) = RecordWrite::parse(rules, index, body) {
@@ -63,9 +65,15 @@ pub fn psd4xx_record(data: &[u8]) {
 
 /// PSx3xx process images of every format and both byte orders; parsed images re-encode exactly.
 pub fn psx3xx_image(data: &[u8]) {
-    let Some((&sel, bytes)) = data.split_first() else { return };
+    let Some((&sel, bytes)) = data.split_first() else {
+        return;
+    };
     let rules = psx();
-    let order = if sel & 0x80 == 0 { rules.wire_order() } else { rules.wire_order().flipped() };
+    let order = if sel & 0x80 == 0 {
+        rules.wire_order()
+    } else {
+        rules.wire_order().flipped()
+    };
     let format = sel % 4;
     if let Ok(out) = drivespec_psx3xx::Output::parse(rules, format, order, bytes) {
         assert_eq!(out.to_bytes(rules, order).unwrap(), bytes);
@@ -84,12 +92,16 @@ pub fn psx3xx_image(data: &[u8]) {
 /// PSx3xx ISDU values: bytes 0–2 pick index and sub-index; a decoded value encodes and
 /// decodes to itself; requests are checked without panicking.
 pub fn psx3xx_isdu(data: &[u8]) {
-    let Some((head, body)) = data.split_first_chunk::<3>() else { return };
+    let Some((head, body)) = data.split_first_chunk::<3>() else {
+        return;
+    };
     let rules = psx();
     let index = u16::from_be_bytes([head[0], head[1]]);
     let subindex = head[2];
     let _ = rules.check_read(index, subindex);
-    let Ok(target) = rules.isdu_target(index, subindex) else { return };
+    let Ok(target) = rules.isdu_target(index, subindex) else {
+        return;
+    };
     if let Ok(value) = rules.decode_value(&target, body) {
         if let Ok(bytes) = rules.encode_value(&target, &value) {
             assert_eq!(rules.decode_value(&target, &bytes).ok(), Some(value));
@@ -100,6 +112,8 @@ pub fn psx3xx_isdu(data: &[u8]) {
 
 /// PSx3xx Direct Parameter page 1: any bytes at any start address decode or fail cleanly.
 pub fn psx3xx_direct(data: &[u8]) {
-    let Some((&first, bytes)) = data.split_first() else { return };
+    let Some((&first, bytes)) = data.split_first() else {
+        return;
+    };
     let _ = psx().decode_direct(first % 32, bytes);
 }
