@@ -37,6 +37,10 @@ pub struct PlcRuntime {
     zero_flag: ZeroFlag,
     requires_stack: bool,
     div_remainder_high: bool,
+    /// FIN disable bits disable at 1 (erratum option `fin-disable`).
+    fin_disabled_at: bool,
+    /// b99.0/b99.1 follow the timer in the same update (erratum option `timer-flag`).
+    timer_flag_same_update: bool,
     constant_result_discarded: bool,
     dword_param: [bool; 256],
     forbidden: [bool; 256],
@@ -93,6 +97,19 @@ impl PlcRuntime {
             Some("nonzero") => ZeroFlag::SetWhenNonZero,
             _ => ZeroFlag::SetWhenZero,
         };
+        // Erratum options (HPD-ERRATUM-051, 054, 059, 068): the adopted reading unless chosen.
+        let reading = |option: &str| readings.reading(family, option);
+        let mut dword_param = numbers(&a.dword_params);
+        if reading("dword-pr69") == Some("pr60-68") {
+            let last = a.dword_params.last().and_then(|s| ParamMap::parse_param(s));
+            if let Some(slot) = last.and_then(|n| dword_param.get_mut(usize::from(n))) {
+                *slot = false;
+            }
+        }
+        let div_remainder_high =
+            a.div_remainder_in_high_word && reading("div-remainder") != Some("quotient32");
+        let fin_disabled_at = reading("fin-disable") != Some("zero-disables");
+        let timer_flag_same_update = reading("timer-flag") != Some("next-update");
         let mut constant = [None; 256];
         for c in &plc.constants {
             if let Some(slot) =
@@ -140,9 +157,11 @@ impl PlcRuntime {
             zero: bit(&a.zero_bit)?,
             zero_flag,
             requires_stack: a.requires_stack,
-            div_remainder_high: a.div_remainder_in_high_word,
+            div_remainder_high,
+            fin_disabled_at,
+            timer_flag_same_update,
             constant_result_discarded: a.constant_result_discarded,
-            dword_param: numbers(&a.dword_params),
+            dword_param,
             forbidden: numbers(&a.forbidden_params),
             constant,
             timers,
@@ -193,10 +212,15 @@ impl PlcRuntime {
                 }
                 ScanStep::UpdateTimers => {
                     for (slot, status) in &self.timers {
-                        let v = mem.get(slot.addr, slot.size);
-                        let v = v.saturating_sub(1);
-                        mem.set(slot.addr, slot.size, v);
-                        mem.set_bit(*status, v == 0);
+                        let old = mem.get(slot.addr, slot.size);
+                        let new = old.saturating_sub(1);
+                        mem.set(slot.addr, slot.size, new);
+                        let expired = if self.timer_flag_same_update {
+                            new == 0
+                        } else {
+                            old == 0
+                        };
+                        mem.set_bit(*status, expired);
                     }
                 }
                 ScanStep::RunProgram => {
@@ -228,7 +252,7 @@ impl PlcRuntime {
             let Operands::Fin { y, n, .. } = instr.operands else {
                 return;
             };
-            if mem.bit(slot.disable) {
+            if mem.bit(slot.disable) == self.fin_disabled_at {
                 continue;
             }
             let Some(target) = self.fin_targets.get(usize::from(n & 1)) else {
