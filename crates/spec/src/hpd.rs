@@ -24,6 +24,8 @@ pub struct Protocol {
     pub serial_setup: SerialSetup,
     /// Inter-drive communication, Pr26 = 10 (3.8.2 example 10).
     pub idc: Idc,
+    /// Command bits and the parameters the drive's commands act on (3.3, 3.4).
+    pub commands: Commands,
     /// Alarm codes shown in Pr23/Pr24 (3.3 table).
     pub alarms: Vec<Alarm>,
     /// The pico-PLC (3.8.1, 4.1).
@@ -361,6 +363,30 @@ pub struct SerialSetup {
     pub steps: Vec<Assignment>,
     /// Settings for the Pcbrush PC program (3.9).
     pub pcbrush: Vec<Assignment>,
+}
+
+/// Command bits and the parameters the drive's commands act on (3.3, 3.4).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Commands {
+    /// Manual section.
+    pub source: String,
+    /// Alarm reset command (3.4 b99.10).
+    pub alarm_reset_bit: String,
+    /// Operating-mode defaults command (3.4 b99.11).
+    pub mode_defaults_bit: String,
+    /// Must be 0 for the operating-mode defaults command (3.4: b40.2 = 0).
+    pub mode_defaults_requires_clear: String,
+    /// Security: locks parameter changes (3.3 b99.7).
+    pub security_bit: String,
+    /// Extended menu, needed by the re-initialisation command (3.3 b99.6, 3.4 b42.3).
+    pub extended_menu_bit: String,
+    /// Active alarm code (3.3 Pr23).
+    pub alarm_param: String,
+    /// Last alarm code (3.3 Pr24).
+    pub last_alarm_param: String,
+    /// Operating mode (3.3 Pr31, 3.6).
+    pub mode_param: String,
 }
 
 /// Inter-drive communication, Pr26 = 10 (3.8.2 example 10).

@@ -225,16 +225,16 @@ impl Layout {
         let plc = &protocol.plc;
         let named = Named {
             enable: bit(&setup_spec.enable_bit)?,
-            security: bit(names::SECURITY)?,
-            extended_menu: bit(names::EXTENDED_MENU)?,
-            reserved_reference: bit(names::RESERVED_REFERENCE)?,
+            security: bit(&protocol.commands.security_bit)?,
+            extended_menu: bit(&protocol.commands.extended_menu_bit)?,
+            reserved_reference: bit(&protocol.commands.mode_defaults_requires_clear)?,
             idc_trigger: bit(&protocol.idc.trigger_bit)?,
             healthy: None,
             baud: slot(&setup_spec.baud_param)?,
             address: slot(&setup_spec.address_param)?,
-            alarm: slot(names::ALARM_CODE)?,
-            last_alarm: slot(names::LAST_ALARM)?,
-            mode: slot(names::OPERATING_MODE)?,
+            alarm: slot(&protocol.commands.alarm_param)?,
+            last_alarm: slot(&protocol.commands.last_alarm_param)?,
+            mode: slot(&protocol.commands.mode_param)?,
             idc_target: slot(&protocol.idc.address_param)?,
             idc_value: slot(&protocol.idc.value_param)?,
         };
@@ -247,8 +247,14 @@ impl Layout {
         };
         let kinds = [
             (setup.reinit, CommandKind::Reinit),
-            (bit(names::ALARM_RESET)?, CommandKind::AlarmReset),
-            (bit(names::MODE_DEFAULTS)?, CommandKind::ModeDefaults),
+            (
+                bit(&protocol.commands.alarm_reset_bit)?,
+                CommandKind::AlarmReset,
+            ),
+            (
+                bit(&protocol.commands.mode_defaults_bit)?,
+                CommandKind::ModeDefaults,
+            ),
             (bit(&plc.default_bit)?, CommandKind::Defaults),
             (bit(&plc.save_bit)?, CommandKind::SavePlc),
             (setup.save, CommandKind::SaveParams),

@@ -1,23 +1,5 @@
-//! Names of the bits and parameters the model acts on that the spec's protocol tables do not
-//! name, and the erratum options it follows. Addresses and masks still come from the spec's
-//! parameter table; only the names are written here.
-
-/// Alarm reset command (manual 3.4 b99.10).
-pub(super) const ALARM_RESET: &str = "b99.10";
-/// Operating-mode defaults command (manual 3.4 b99.11).
-pub(super) const MODE_DEFAULTS: &str = "b99.11";
-/// Security (manual 3.3 b99.7).
-pub(super) const SECURITY: &str = "b99.7";
-/// Extended menu, needed by b42.3 (manual 3.3 b99.6, 3.4).
-pub(super) const EXTENDED_MENU: &str = "b99.6";
-/// Reserved reference select, must be 0 for b99.11 (manual 3.3 b40.2, 3.4).
-pub(super) const RESERVED_REFERENCE: &str = "b40.2";
-/// Active alarm (manual 3.3 Pr23).
-pub(super) const ALARM_CODE: &str = "Pr23";
-/// Last alarm (manual 3.3 Pr24).
-pub(super) const LAST_ALARM: &str = "Pr24";
-/// Operating mode (manual 3.3 Pr31, 3.6).
-pub(super) const OPERATING_MODE: &str = "Pr31";
+//! The names by which the model finds its rules in the spec: bit-rule triggers (bits.toml)
+//! and the erratum options and readings it follows (errata-*.toml).
 
 /// Bit-rule trigger of command bits the drive executes (bits.toml).
 pub(super) const TRIGGER_COMMAND: &str = "command-executed";
