@@ -2,7 +2,12 @@
 //! three output formats and the input image, and the full field-by-field explanation.
 //!
 //! `cargo run --release -p drivespec-psx3xx --example bench_images [MILLIONS]` (default 4).
-#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
 
 use drivespec_psx3xx::{explain_input, explain_output, Input, Output, Rules};
 use drivespec_spec::Spec;
@@ -10,7 +15,10 @@ use std::hint::black_box;
 use std::time::Instant;
 
 fn main() {
-    let millions: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(4);
+    let millions: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(4);
     let spec = Spec::builtin().expect("built-in spec");
     let rules = Rules::from_spec(&spec).expect("PSx3xx rules");
     let order = rules.wire_order();
@@ -20,10 +28,23 @@ fn main() {
         let fields: Vec<(&str, i64)> = match format {
             0 => vec![("control", i % 4), ("stamp", 2000 + i)],
             1 => vec![("control_word", 0x14), ("target", i * 1000)],
-            _ => vec![("target_speed", 100 + i), ("control_word", 0x14), ("target", i * 1000)],
+            _ => vec![
+                ("target_speed", 100 + i),
+                ("control_word", 0x14),
+                ("target", i * 1000),
+            ],
         };
-        let out = Output::from_fields(&rules, format, &fields).unwrap().to_bytes(&rules, order).unwrap();
-        let inp = Input::from_fields(&rules, &[("status", 0x11), ("rpm", i - 128), ("actual", i * 997)]).unwrap().to_bytes(&rules, order).unwrap();
+        let out = Output::from_fields(&rules, format, &fields)
+            .unwrap()
+            .to_bytes(&rules, order)
+            .unwrap();
+        let inp = Input::from_fields(
+            &rules,
+            &[("status", 0x11), ("rpm", i - 128), ("actual", i * 997)],
+        )
+        .unwrap()
+        .to_bytes(&rules, order)
+        .unwrap();
         images.push((format, out, inp));
     }
     let n = millions * 1_000_000;
