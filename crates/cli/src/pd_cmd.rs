@@ -103,15 +103,7 @@ pub fn decode_psd4xx(args: Psd4xxDecode, ctx: &Context) -> Result<Outcome> {
     let spec = ctx.spec()?;
     let rules = psd_rules(&spec, args.byte_order)?;
     let e = drivespec_psd4xx::explain(&rules, psd_direction(&args.dir), &bytes)?;
-    match ctx.format {
-        Format::Json => println!("{}", json(&e)),
-        Format::Text => print_text(&e),
-    }
-    Ok(if e.notes.is_empty() {
-        Outcome::Pass
-    } else {
-        Outcome::Fail
-    })
+    Ok(report(ctx, &e, e.notes.is_empty()))
 }
 
 /// Runs `drivespec encode psd4xx`.
@@ -256,15 +248,7 @@ pub fn decode_psx3xx(args: Psx3xxDecode, ctx: &Context) -> Result<Outcome> {
     } else {
         drivespec_psx3xx::explain_input(&rules, order, model, &bytes)?
     };
-    match ctx.format {
-        Format::Json => println!("{}", json(&e)),
-        Format::Text => print_text(&e),
-    }
-    Ok(if e.warnings.is_empty() {
-        Outcome::Pass
-    } else {
-        Outcome::Fail
-    })
+    Ok(report(ctx, &e, e.warnings.is_empty()))
 }
 
 /// Runs `drivespec encode psx3xx`.
@@ -301,7 +285,15 @@ pub fn encode_psx3xx(args: Psx3xxEncode, ctx: &Context) -> Result<Outcome> {
     }
 }
 
-/// Prints a text explanation ending with exactly one newline.
-fn print_text(e: &impl std::fmt::Display) {
-    println!("{}", e.to_string().trim_end());
+/// Prints an explanation (text ending in one newline, or JSON); fails when it is not `clean`.
+fn report<E: std::fmt::Display + serde::Serialize>(ctx: &Context, e: &E, clean: bool) -> Outcome {
+    match ctx.format {
+        Format::Json => println!("{}", json(e)),
+        Format::Text => println!("{}", e.to_string().trim_end()),
+    }
+    if clean {
+        Outcome::Pass
+    } else {
+        Outcome::Fail
+    }
 }
