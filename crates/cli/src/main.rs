@@ -1,5 +1,6 @@
 //! `drivespec`: the command-line front end. Parsing and printing only; the work is in the libraries.
 
+mod conform_cmd;
 mod hpd_cmd;
 mod pd_cmd;
 mod spec_cmd;
@@ -38,6 +39,8 @@ enum Command {
         #[command(subcommand)]
         device: EncodeDevice,
     },
+    /// Run the conformance suite against a device under test (exit 1 on failures).
+    Conform(conform_cmd::ConformArgs),
     /// Assemble and disassemble PLC programs.
     Plc {
         #[command(subcommand)]
@@ -141,6 +144,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Spec(args) => spec_cmd::run(args, &ctx),
+        Command::Conform(args) => conform_cmd::run(args, &ctx),
         Command::Decode { device } => match device {
             DecodeDevice::Hpd(args) => hpd_cmd::decode(args, &ctx),
             DecodeDevice::Psd4xx(args) => pd_cmd::decode_psd4xx(args, &ctx),

@@ -1,0 +1,172 @@
+//! `drivespec conform`: argument parsing and printing around `drivespec_conform::run`.
+
+use crate::{json, Context, Format, Outcome};
+use anyhow::{bail, Result};
+use drivespec_conform::dut::Dut;
+use drivespec_conform::report::Status;
+use drivespec_conform::select::LevelFilter;
+use drivespec_conform::suite::Settings;
+use drivespec_conform::{Options, Progress};
+use drivespec_spec::FamilyId;
+use std::path::PathBuf;
+
+/// Run the conformance suite against a device under test.
+#[derive(clap::Args)]
+pub struct ConformArgs {
+    /// Family: hpd, psd4xx, psx3xx or all.
+    family: String,
+    /// Device under test: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS'.
+    #[arg(long, default_value = "sim")]
+    dut: String,
+    /// Device model.
+    #[arg(long)]
+    model: Option<String>,
+    /// Run only cases matching this glob (repeatable; `*` also matches `/`).
+    #[arg(long = "case", value_name = "GLOB")]
+    case: Vec<String>,
+    /// Skip cases matching this glob (repeatable).
+    #[arg(long, value_name = "GLOB")]
+    skip: Vec<String>,
+    /// Run `must` cases only, or `must` and `should` cases.
+    #[arg(long, value_enum, default_value_t = LevelArg::Should)]
+    level: LevelArg,
+    /// Known failures, each with a reason (TOML `[[failure]] case = …, reason = …`).
+    #[arg(long, value_name = "FILE")]
+    expect: Option<PathBuf>,
+    /// List the selected cases and run nothing.
+    #[arg(long)]
+    list: bool,
+    /// Stop at the first unexpected failure.
+    #[arg(long)]
+    fail_fast: bool,
+    /// Seed of the values the cases pick.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Serial address of the device (HPD Pr27).
+    #[arg(long, default_value_t = 0)]
+    address: u8,
+    /// Extra time allowed for each answer on real transports, in ms.
+    #[arg(long, value_name = "MS")]
+    slack_ms: Option<u64>,
+    /// Folder of the reports.
+    #[arg(long, default_value = "reports", value_name = "DIR")]
+    report_dir: PathBuf,
+    /// JUnit XML file (default DIR/conform.junit.xml).
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
+    /// JSON report file (default DIR/conform.json).
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// HTML report file (default DIR/conform.html).
+    #[arg(long, value_name = "FILE")]
+    html: Option<PathBuf>,
+    /// No progress output.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LevelArg {
+    Must,
+    Should,
+}
+
+/// Runs `drivespec conform`.
+pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
+    let families = if args.family.eq_ignore_ascii_case("all") {
+        Vec::new()
+    } else {
+        match FamilyId::parse(&args.family) {
+            Some(f) => vec![f],
+            None => bail!(
+                "unknown family {:?}: hpd, psd4xx, psx3xx or all",
+                args.family
+            ),
+        }
+    };
+    let dut: Dut = args.dut.parse()?;
+    let opts = Options {
+        families,
+        dut,
+        settings: Settings {
+            address: args.address,
+            seed: args.seed,
+            model: args.model,
+            slack_us: args.slack_ms.map(|ms| ms.saturating_mul(1000)),
+            bit_rate: None,
+        },
+        case: args.case,
+        skip: args.skip,
+        level: match args.level {
+            LevelArg::Must => LevelFilter::Must,
+            LevelArg::Should => LevelFilter::Should,
+        },
+        expect: args.expect,
+        list: args.list,
+        fail_fast: args.fail_fast,
+        report_dir: args.report_dir,
+        junit: args.junit,
+        json: args.json,
+        html: args.html,
+        no_reports: false,
+        progress: if args.quiet {
+            Progress::Quiet
+        } else {
+            Progress::Auto
+        },
+        command: "drivespec conform".to_owned(),
+    };
+    let spec = ctx.spec()?;
+    let mut err = std::io::stderr();
+    let summary = drivespec_conform::run(&spec, &opts, &mut err)?;
+    if opts.list {
+        match ctx.format {
+            Format::Json => println!("{}", json(&serde_json::json!({ "cases": summary.listed }))),
+            Format::Text => {
+                for c in &summary.listed {
+                    println!("{:<48} {:<6} {}", c.id, c.level.as_str(), c.description);
+                }
+                println!("{} case(s)", summary.listed.len());
+            }
+        }
+        return Ok(Outcome::Pass);
+    }
+    let r = &summary.report;
+    let s = r.summary;
+    match ctx.format {
+        Format::Json => println!(
+            "{}",
+            json(&serde_json::json!({
+                "summary": s,
+                "reports": summary.written,
+                "unavailable": r.run.unavailable,
+            }))
+        ),
+        Format::Text => {
+            for u in &r.run.unavailable {
+                println!("{}: {}", u.family, u.reason);
+            }
+            for c in r.cases.iter().filter(|c| c.status == Status::Fixed) {
+                println!(
+                    "fixed: {} passes; remove it from the expectations file",
+                    c.id
+                );
+            }
+            for k in &r.stale_expectations {
+                println!("stale expectation: {} matches no selected case", k.case);
+            }
+            println!(
+                "{} passed, {} failed, {} skipped ({} expected failures, {} fixed, {} not run) of {} cases against {}",
+                s.passed, s.failed, s.skipped, s.expected_failures, s.fixed, s.not_run, s.total, r.run.transport
+            );
+            for w in &summary.written {
+                println!("report: {}", w.display());
+            }
+        }
+    }
+    Ok(if summary.exit_code() == 0 {
+        Outcome::Pass
+    } else {
+        Outcome::Fail
+    })
+}

@@ -1,0 +1,259 @@
+//! `--dut`: where the device under test is.
+//!
+//! | form | meaning |
+//! | --- | --- |
+//! | `sim` or `sim:MODEL` | the built-in reference model (default) |
+//! | `serial:/dev/ttyUSB0?baud=57600` | a serial line, 8E1 (manual 4.1) |
+//! | `tcp:HOST:PORT` | a raw byte stream (ser2net, a simulator) |
+//! | `exec:COMMAND ARGS` | a subprocess speaking the protocol on stdin/stdout |
+
+use std::fmt;
+use std::str::FromStr;
+
+/// Where the device under test is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Dut {
+    /// The built-in reference model, optionally for one device model.
+    Sim {
+        /// Device model name (`HPD5`), matched forgivingly.
+        model: Option<String>,
+    },
+    /// A serial port.
+    Serial {
+        /// Port path (`/dev/ttyUSB0`, `COM3`).
+        path: String,
+        /// Bits per second; None: the delivery value of the baud-rate parameter.
+        baud: Option<u32>,
+    },
+    /// A TCP byte stream.
+    Tcp {
+        /// `HOST:PORT`.
+        addr: String,
+    },
+    /// A subprocess on stdin/stdout.
+    Exec {
+        /// Program and arguments, split like a shell does (quotes and backslashes).
+        argv: Vec<String>,
+    },
+}
+
+impl Default for Dut {
+    fn default() -> Dut {
+        Dut::Sim { model: None }
+    }
+}
+
+/// Why a `--dut` text is not usable.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("--dut {text:?}: {why} (forms: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS')")]
+pub struct DutError {
+    /// The text given.
+    pub text: String,
+    /// What is wrong.
+    pub why: String,
+}
+
+impl FromStr for Dut {
+    type Err = DutError;
+
+    fn from_str(s: &str) -> Result<Dut, DutError> {
+        let text = s.trim();
+        let bad = |why: &str| DutError {
+            text: text.to_owned(),
+            why: why.to_owned(),
+        };
+        let (kind, rest) = text.split_once(':').unwrap_or((text, ""));
+        match kind.to_ascii_lowercase().as_str() {
+            "sim" => Ok(Dut::Sim {
+                model: Some(rest.trim())
+                    .filter(|m| !m.is_empty())
+                    .map(str::to_owned),
+            }),
+            "serial" => {
+                let (path, query) = rest.split_once('?').unwrap_or((rest, ""));
+                if path.trim().is_empty() {
+                    return Err(bad("no port path"));
+                }
+                let mut baud = None;
+                for pair in query.split('&').filter(|p| !p.is_empty()) {
+                    match pair.split_once('=') {
+                        Some(("baud", v)) => {
+                            baud = Some(v.parse::<u32>().map_err(|_| bad("baud is not a number"))?)
+                        }
+                        _ => return Err(bad(&format!("unknown option {pair:?} (known: baud)"))),
+                    }
+                }
+                Ok(Dut::Serial {
+                    path: path.trim().to_owned(),
+                    baud,
+                })
+            }
+            "tcp" => {
+                let ok = rest
+                    .rsplit_once(':')
+                    .is_some_and(|(h, p)| !h.is_empty() && p.parse::<u16>().is_ok());
+                if !ok {
+                    return Err(bad("expected tcp:HOST:PORT"));
+                }
+                Ok(Dut::Tcp {
+                    addr: rest.to_owned(),
+                })
+            }
+            "exec" => {
+                let argv = split_command(rest).map_err(bad)?;
+                if argv.is_empty() {
+                    return Err(bad("no command"));
+                }
+                Ok(Dut::Exec { argv })
+            }
+            _ => Err(bad("unknown transport")),
+        }
+    }
+}
+
+impl fmt::Display for Dut {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Dut::Sim { model: None } => f.write_str("sim"),
+            Dut::Sim { model: Some(m) } => write!(f, "sim:{m}"),
+            Dut::Serial { path, baud: None } => write!(f, "serial:{path}"),
+            Dut::Serial {
+                path,
+                baud: Some(b),
+            } => write!(f, "serial:{path}?baud={b}"),
+            Dut::Tcp { addr } => write!(f, "tcp:{addr}"),
+            Dut::Exec { argv } => {
+                let words: Vec<String> = argv.iter().map(|w| shell_quote(w)).collect();
+                write!(f, "exec:{}", words.join(" "))
+            }
+        }
+    }
+}
+
+/// Splits a command line into words: blanks separate, `'…'` and `"…"` quote, `\` escapes.
+pub fn split_command(s: &str) -> Result<Vec<String>, &'static str> {
+    let mut words = Vec::new();
+    let mut cur = String::new();
+    let mut in_word = false;
+    let mut chars = s.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '\'' => {
+                in_word = true;
+                loop {
+                    match chars.next() {
+                        Some('\'') => break,
+                        Some(c) => cur.push(c),
+                        None => return Err("unterminated ' quote"),
+                    }
+                }
+            }
+            '"' => {
+                in_word = true;
+                loop {
+                    match chars.next() {
+                        Some('"') => break,
+                        Some('\\') => match chars.next() {
+                            Some(c) => cur.push(c),
+                            None => return Err("trailing backslash"),
+                        },
+                        Some(c) => cur.push(c),
+                        None => return Err("unterminated \" quote"),
+                    }
+                }
+            }
+            '\\' => {
+                in_word = true;
+                match chars.next() {
+                    Some(c) => cur.push(c),
+                    None => return Err("trailing backslash"),
+                }
+            }
+            c if c.is_whitespace() => {
+                if in_word {
+                    words.push(std::mem::take(&mut cur));
+                    in_word = false;
+                }
+            }
+            c => {
+                in_word = true;
+                cur.push(c);
+            }
+        }
+    }
+    if in_word {
+        words.push(cur);
+    }
+    Ok(words)
+}
+
+/// A word quoted for a POSIX shell when it needs it.
+pub fn shell_quote(w: &str) -> String {
+    let plain = !w.is_empty()
+        && w.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./:=@%+,".contains(c));
+    if plain {
+        w.to_owned()
+    } else {
+        format!("'{}'", w.replace('\'', r"'\''"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_every_form() {
+        assert_eq!("sim".parse::<Dut>().unwrap(), Dut::Sim { model: None });
+        assert_eq!(
+            "sim:HPD5".parse::<Dut>().unwrap(),
+            Dut::Sim {
+                model: Some("HPD5".into())
+            }
+        );
+        assert_eq!(
+            "serial:/dev/ttyUSB0?baud=57600".parse::<Dut>().unwrap(),
+            Dut::Serial {
+                path: "/dev/ttyUSB0".into(),
+                baud: Some(57600)
+            }
+        );
+        assert_eq!(
+            "tcp:127.0.0.1:5000".parse::<Dut>().unwrap(),
+            Dut::Tcp {
+                addr: "127.0.0.1:5000".into()
+            }
+        );
+        assert_eq!(
+            "exec:python3 'my adapter.py' --x".parse::<Dut>().unwrap(),
+            Dut::Exec {
+                argv: vec!["python3".into(), "my adapter.py".into(), "--x".into()]
+            }
+        );
+        for bad in [
+            "tcp:host",
+            "serial:",
+            "serial:/dev/x?speed=1",
+            "exec:",
+            "exec:'x",
+            "usb:1",
+        ] {
+            assert!(bad.parse::<Dut>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn display_round_trips() {
+        for s in [
+            "sim",
+            "sim:HPD5",
+            "serial:/dev/ttyS0?baud=9600",
+            "tcp:127.0.0.1:9",
+            "exec:python3 'a b.py'",
+        ] {
+            let d: Dut = s.parse().unwrap();
+            assert_eq!(d.to_string().parse::<Dut>().unwrap(), d);
+        }
+    }
+}

@@ -1,0 +1,642 @@
+//! Building HPD cases: the vocabulary (read, write, bit change, set-up and clean-up of the
+//! PLC, the operating mode and the serial address) and the requirements each step exercises.
+
+use super::names;
+use super::step::{Action, Compare, HpdCase, Step};
+use crate::case::{CaseInfo, Role};
+use crate::rng::Rng;
+use drivespec_hpd::memory::{BitAddr, ParamMap, Slot};
+use drivespec_hpd::model::Drive;
+use drivespec_hpd::params::Target;
+use drivespec_hpd::plc::PlcCodec;
+use drivespec_hpd::{Data, FrameRules, Message, MessageKind};
+use drivespec_spec::hpd::Protocol;
+use drivespec_spec::{Family, FamilyId, Level, Parameter, Ranges, Spec};
+use std::collections::BTreeSet;
+
+/// A case being written.
+pub(crate) struct CaseB {
+    pub(crate) id: String,
+    pub(crate) description: String,
+    pub(crate) explicit: Vec<String>,
+    pub(crate) steps: Vec<Step>,
+    pub(crate) needs_power_cycle: bool,
+    pub(crate) touched: Vec<Slot>,
+    pub(crate) level: Option<Level>,
+}
+
+impl CaseB {
+    pub(crate) fn new(
+        id: impl Into<String>,
+        description: impl Into<String>,
+        reqs: &[&str],
+    ) -> CaseB {
+        CaseB {
+            id: id.into(),
+            description: description.into(),
+            explicit: reqs.iter().map(|r| (*r).to_owned()).collect(),
+            steps: Vec::new(),
+            needs_power_cycle: false,
+            touched: Vec::new(),
+            level: None,
+        }
+    }
+
+    /// Adds requirements of the case itself.
+    pub(crate) fn reqs(&mut self, reqs: impl IntoIterator<Item = String>) {
+        for r in reqs {
+            if !self.explicit.contains(&r) {
+                self.explicit.push(r);
+            }
+        }
+    }
+
+    /// Declares the case's level instead of deriving it from its requirements.
+    pub(crate) fn level(&mut self, level: Level) {
+        self.level = Some(level);
+    }
+
+    /// A step that is not a message.
+    pub(crate) fn action(
+        &mut self,
+        role: Role,
+        action: Action,
+        text: impl Into<String>,
+        reqs: &[&str],
+    ) {
+        if matches!(action, Action::PowerCycle) {
+            self.needs_power_cycle = true;
+        }
+        self.steps.push(Step {
+            role,
+            action,
+            text: text.into(),
+            requirements: reqs.iter().map(|r| (*r).to_owned()).collect(),
+        });
+    }
+}
+
+/// Everything fixed while cases are generated.
+pub(crate) struct Gen<'s> {
+    pub(crate) family: &'s Family,
+    pub(crate) protocol: &'s Protocol,
+    pub(crate) rules: FrameRules,
+    pub(crate) map: ParamMap,
+    pub(crate) codec: PlcCodec,
+    pub(crate) baseline: Drive,
+    pub(crate) model: Option<&'s drivespec_spec::DeviceModel>,
+    /// The device's own address (Pr27).
+    pub(crate) addr: u8,
+    pub(crate) rng: Rng,
+    pub(crate) cases: Vec<(CaseInfo, HpdCase)>,
+    pub(crate) errors: Vec<String>,
+    /// Pb99 and the PLC run bit b99.13.
+    pub(crate) run: (Slot, BitAddr),
+}
+
+/// A bit of a parameter by name: the parameter, its slot, the bit number and byte address.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BitRef<'s> {
+    pub(crate) param: &'s Parameter,
+    pub(crate) slot: Slot,
+    pub(crate) bit: u32,
+    pub(crate) at: BitAddr,
+}
+
+impl<'s> Gen<'s> {
+    pub(crate) fn new(
+        spec: &'s Spec,
+        baseline: Drive,
+        model: Option<&'s drivespec_spec::DeviceModel>,
+        addr: u8,
+        seed: u64,
+    ) -> Result<Gen<'s>, String> {
+        let family = spec.family(FamilyId::Hpd);
+        let protocol = family.hpd().ok_or("no HPD protocol table")?;
+        let rules = FrameRules::from_spec(spec).map_err(|e| e.to_string())?;
+        let codec = PlcCodec::from_spec(spec).ok_or("no PLC tables")?;
+        let map = ParamMap::from_spec(spec);
+        let mut g = Gen {
+            family,
+            protocol,
+            rules,
+            map,
+            codec,
+            baseline,
+            model,
+            addr,
+            rng: Rng::new(seed),
+            cases: Vec::new(),
+            errors: Vec::new(),
+            run: (Slot { addr: 0, size: 0 }, BitAddr { byte: 0, mask: 0 }),
+        };
+        let run = g.bit_ref(&protocol.plc.run_bit).ok_or("no PLC run bit")?;
+        g.run = (run.slot, run.at);
+        Ok(g)
+    }
+
+    // ------------------------------------------------------------------ lookups
+
+    /// A parameter by id (`Pr33`, `Pb99`).
+    pub(crate) fn param(&self, id: &str) -> Option<&'s Parameter> {
+        self.family.parameter(id)
+    }
+
+    /// Serial slot of a parameter.
+    pub(crate) fn slot(&self, p: &Parameter) -> Option<Slot> {
+        let addr = u8::try_from(p.address?).ok()?;
+        let size = u8::try_from(p.size?).ok()?;
+        Some(Slot { addr, size })
+    }
+
+    /// Slot of a parameter by id.
+    pub(crate) fn slot_of(&self, id: &str) -> Option<Slot> {
+        self.param(id).and_then(|p| self.slot(p))
+    }
+
+    /// A bit by name (`b99.13`).
+    pub(crate) fn bit_ref(&self, name: &str) -> Option<BitRef<'s>> {
+        let target = Target::parse(self.family, name).ok()?;
+        let Target::Bit(param, bit) = target else {
+            return None;
+        };
+        let slot = self.slot(param)?;
+        let (n, y) = ParamMap::parse_bit(name)?;
+        let at = self.map.bit(n, y)?;
+        Some(BitRef {
+            param,
+            slot,
+            bit,
+            at,
+        })
+    }
+
+    /// The raw start value of a slot (the reference drive as commissioned).
+    pub(crate) fn base(&self, slot: Slot) -> u32 {
+        self.baseline.memory().get(slot.addr, slot.size)
+    }
+
+    /// The range of a parameter in operating mode `mode` (manual 3.3, 3.6).
+    pub(crate) fn range_in(&self, p: &Parameter, mode: Option<u32>) -> Option<Ranges> {
+        if let Some(m) = mode {
+            if let Some(r) = p
+                .modes
+                .iter()
+                .find(|e| e.modes.contains(&m))
+                .and_then(|e| e.range.clone())
+            {
+                return Some(r);
+            }
+        }
+        self.family.resolve(p, self.model).range
+    }
+
+    /// The requirement IDs in the spec (so cases never cite a missing one).
+    pub(crate) fn known(&self, id: &str) -> bool {
+        self.family.requirement(id).is_some()
+    }
+
+    /// Must/should requirements that name `p` and whose text satisfies `pred`.
+    pub(crate) fn linked(&self, p: &Parameter, pred: impl Fn(&str) -> bool) -> Vec<String> {
+        self.family
+            .requirements
+            .iter()
+            .filter(|r| r.level != Level::Informative && r.params.contains(&p.id) && pred(&r.text))
+            .map(|r| r.id.clone())
+            .collect()
+    }
+
+    // ------------------------------------------------------------------ messages
+
+    pub(crate) fn bytes(&mut self, msg: &Message) -> Vec<u8> {
+        match msg.to_bytes(&self.rules) {
+            Ok(b) => b,
+            Err(e) => {
+                self.errors.push(format!("{msg:?}: {e}"));
+                Vec::new()
+            }
+        }
+    }
+
+    /// Requirements a correct request of this kind exercises (manual 4.1 table), with the
+    /// answer the reference gives.
+    fn auto_reqs(&self, msg: &Message, bytes: &[u8]) -> Vec<&'static str> {
+        let mut r: Vec<&'static str> = vec!["HPD-FRAME-001", "HPD-FRAME-006"];
+        match msg.kind() {
+            MessageKind::ReadParam => r.extend([
+                "HPD-FRAME-014",
+                "HPD-FRAME-010",
+                "HPD-FRAME-009",
+                "HPD-FRAME-008",
+                "HPD-SERIAL-017",
+                "HPD-SERIAL-015",
+            ]),
+            MessageKind::WriteParam => r.extend([
+                "HPD-FRAME-015",
+                "HPD-FRAME-011",
+                "HPD-FRAME-008",
+                "HPD-SERIAL-015",
+            ]),
+            MessageKind::BitChange => r.extend([
+                "HPD-FRAME-016",
+                "HPD-FRAME-017",
+                "HPD-FRAME-018",
+                "HPD-FRAME-011",
+            ]),
+            MessageKind::ReadPlc => r.extend([
+                "HPD-FRAME-012",
+                "HPD-FRAME-010",
+                "HPD-FRAME-009",
+                "HPD-FRAME-022",
+            ]),
+            MessageKind::WritePlc => r.extend(["HPD-FRAME-013", "HPD-FRAME-011", "HPD-FRAME-022"]),
+            MessageKind::Broadcast => r.extend(["HPD-FRAME-019", "HPD-SERIAL-013"]),
+            MessageKind::Response => r.push("HPD-SERIAL-001"),
+        }
+        let multi = match msg {
+            Message::ReadParam { lun, .. } | Message::ReadPlc { lun, .. } => *lun > 1,
+            Message::WriteParam { data, .. } | Message::Broadcast { data, .. } => data.len() > 1,
+            _ => false,
+        };
+        if multi {
+            r.push("HPD-SERIAL-016");
+        }
+        if bytes
+            .windows(2)
+            .skip(1)
+            .any(|w| w == [self.rules.stx, self.rules.stuff])
+        {
+            r.extend(["HPD-FRAME-003", "HPD-FRAME-004"]);
+        }
+        r
+    }
+
+    /// A message step with the requirements it exercises.
+    pub(crate) fn msg(
+        &mut self,
+        cb: &mut CaseB,
+        role: Role,
+        msg: Message,
+        compare: Compare,
+        text: impl Into<String>,
+    ) {
+        let bytes = self.bytes(&msg);
+        let reqs = self.auto_reqs(&msg, &bytes);
+        if let Message::WriteParam { par, data, .. } | Message::Broadcast { par, data } = msg {
+            self.touch(cb, par, data.len());
+        }
+        if let Message::BitChange { par, .. } = msg {
+            self.touch(cb, par, 1);
+        }
+        cb.steps.push(Step {
+            role,
+            action: Action::Exchange {
+                bytes,
+                compare,
+                silence_ok: false,
+                golden: None,
+            },
+            text: text.into(),
+            requirements: reqs.iter().map(|s| (*s).to_owned()).collect(),
+        });
+    }
+
+    /// Raw bytes (malformed frames) with the requirements given.
+    pub(crate) fn raw(
+        &mut self,
+        cb: &mut CaseB,
+        role: Role,
+        bytes: Vec<u8>,
+        text: impl Into<String>,
+        reqs: &[&str],
+    ) {
+        let mut reqs: Vec<&str> = reqs.to_vec();
+        // A well-formed request exercises what its message type does.
+        if let Ok(m) = drivespec_hpd::parse(&self.rules, &bytes) {
+            if m.is_request() {
+                for r in self.auto_reqs(&m, &bytes) {
+                    if !reqs.contains(&r) {
+                        reqs.push(r);
+                    }
+                }
+            }
+        }
+        cb.steps.push(Step {
+            role,
+            action: Action::Exchange {
+                bytes,
+                compare: Compare::Exact,
+                silence_ok: false,
+                golden: None,
+            },
+            text: text.into(),
+            requirements: reqs.iter().map(|s| (*s).to_owned()).collect(),
+        });
+    }
+
+    fn touch(&self, cb: &mut CaseB, par: u8, len: u8) {
+        for i in 0..len {
+            let Some(a) = par.checked_add(i) else { break };
+            if let Some(p) = self.family.parameter_at_address(u32::from(a)) {
+                if let Some(s) = self.slot(p) {
+                    if !cb.touched.contains(&s) {
+                        cb.touched.push(s);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Read `slot` from the drive at `at`.
+    pub(crate) fn read_at(
+        &mut self,
+        cb: &mut CaseB,
+        role: Role,
+        at: u8,
+        slot: Slot,
+        compare: Compare,
+        what: &str,
+    ) {
+        let msg = Message::ReadParam {
+            addr: at,
+            lun: slot.size,
+            par: slot.addr,
+        };
+        self.msg(
+            cb,
+            role,
+            msg,
+            compare,
+            format!("read {what} from drive {at}"),
+        );
+    }
+
+    /// Read `slot` from the device.
+    pub(crate) fn read(
+        &mut self,
+        cb: &mut CaseB,
+        role: Role,
+        slot: Slot,
+        compare: Compare,
+        what: &str,
+    ) {
+        self.read_at(cb, role, self.addr, slot, compare, what);
+    }
+
+    /// Write raw `value` to `slot` of the drive at `at`.
+    pub(crate) fn write_at(
+        &mut self,
+        cb: &mut CaseB,
+        role: Role,
+        at: u8,
+        slot: Slot,
+        value: i64,
+        what: &str,
+    ) {
+        let Some(data) = Data::from_value(value, slot.size) else {
+            self.errors
+                .push(format!("{}: {what} = {value} does not fit", cb.id));
+            return;
+        };
+        let msg = Message::WriteParam {
+            addr: at,
+            par: slot.addr,
+            data,
+        };
+        self.msg(
+            cb,
+            role,
+            msg,
+            Compare::Exact,
+            format!("write {what} = {value} to drive {at}"),
+        );
+    }
+
+    /// Write raw `value` to `slot` of the device.
+    pub(crate) fn write(&mut self, cb: &mut CaseB, role: Role, slot: Slot, value: i64, what: &str) {
+        self.write_at(cb, role, self.addr, slot, value, what);
+    }
+
+    /// Set or clear one bit with a bit change (manual 4.1 CMD 6).
+    pub(crate) fn bit(&mut self, cb: &mut CaseB, role: Role, b: &BitRef<'_>, value: bool) {
+        self.bit_at(cb, role, self.addr, b, value);
+    }
+
+    pub(crate) fn bit_at(
+        &mut self,
+        cb: &mut CaseB,
+        role: Role,
+        at: u8,
+        b: &BitRef<'_>,
+        value: bool,
+    ) {
+        let Some((par, mask, bits)) =
+            drivespec_hpd::params::bit_change(self.family, b.slot.addr, b.bit, value)
+        else {
+            self.errors.push(format!(
+                "{}: no bit change for b{}.{}",
+                cb.id, b.param.number, b.bit
+            ));
+            return;
+        };
+        let msg = Message::BitChange {
+            addr: at,
+            par,
+            mask,
+            value: bits,
+        };
+        let name = format!("b{}.{}", b.param.number, b.bit);
+        self.msg(
+            cb,
+            role,
+            msg,
+            Compare::Exact,
+            format!("set {name} = {} on drive {at}", u8::from(value)),
+        );
+    }
+
+    /// How to compare a read of parameter `p` (in operating mode `mode`).
+    pub(crate) fn compare_for(&self, p: &Parameter, mode: Option<u32>) -> Compare {
+        let width = p.size.unwrap_or(2).min(4) * 8;
+        let all = if width >= 32 {
+            u32::MAX
+        } else {
+            (1u32 << width) - 1
+        };
+        let is_timer = self.protocol.plc.timers.iter().any(|t| t.param == p.id);
+        if is_timer {
+            // Timers count down every scan (manual 3.8.1): ± 64 scans (about 0.4 s).
+            return Compare::Near { tolerance: 64 };
+        }
+        if !p.live {
+            return Compare::Exact;
+        }
+        if self.family.bitfields_of(&p.id).next().is_some() {
+            // Bits the drive sets itself (access r) are not compared.
+            let mut drive_owned = 0u32;
+            for bf in self.family.bitfields_of(&p.id) {
+                let applies = bf.modes.is_empty() || mode.is_some_and(|m| bf.modes.contains(&m));
+                if !applies {
+                    continue;
+                }
+                for b in &bf.bits {
+                    if b.access == Some(drivespec_spec::Access::R) {
+                        drive_owned |= 1u32.checked_shl(b.bit).unwrap_or(0);
+                    }
+                }
+            }
+            return Compare::Mask(all & !drive_owned);
+        }
+        if p.access.writable() {
+            Compare::Exact
+        } else {
+            Compare::Mask(0)
+        }
+    }
+
+    // ------------------------------------------------------------------ state
+
+    /// Setup: stop the PLC (b99.13 = 0, manual 3.2: the default program drives Pr5, Pr92 and
+    /// bits of Pb40 and Pb91 while it runs), with a word write of Pb99.
+    pub(crate) fn stop_plc(&mut self, cb: &mut CaseB) {
+        let (slot, at) = self.run;
+        let value = self.base(slot) & !bit_value(slot, at);
+        self.write(
+            cb,
+            Role::Setup,
+            slot,
+            i64::from(value),
+            "Pb99 (PLC stopped)",
+        );
+    }
+
+    /// Cleanup: Pb99 as at the start (PLC running).
+    pub(crate) fn restore_pb99(&mut self, cb: &mut CaseB) {
+        let (slot, _) = self.run;
+        let v = self.base(slot);
+        self.write(
+            cb,
+            Role::Cleanup,
+            slot,
+            i64::from(v),
+            "Pb99 (as at the start)",
+        );
+    }
+
+    /// Cleanup: a parameter back to its start value.
+    pub(crate) fn restore(&mut self, cb: &mut CaseB, slot: Slot, what: &str) {
+        self.restore_at(cb, self.addr, slot, what);
+    }
+
+    /// Cleanup: a parameter of the drive at `at` back to its start value.
+    pub(crate) fn restore_at(&mut self, cb: &mut CaseB, at: u8, slot: Slot, what: &str) {
+        let v = self.base(slot);
+        let v = sign_for(slot, v, self.family);
+        self.write_at(cb, Role::Cleanup, at, slot, v, what);
+    }
+
+    /// Re-addresses the device from `from` to `to` (manual 4.1 set-up: Pr27, b99.6 for b42.3,
+    /// then b42.3), with word writes. Leaves the PLC stopped and b99.6 = 1.
+    pub(crate) fn readdress(&mut self, cb: &mut CaseB, role: Role, from: u8, to: u8) {
+        let (Some(pr27), Some(pb42), Some(reinit), Some(ext)) = (
+            self.slot_of(&self.protocol.serial_setup.address_param),
+            self.slot_of("Pb42"),
+            self.bit_ref(&self.protocol.serial_setup.reinit_bit),
+            self.bit_ref(names::EXTENDED_MENU),
+        ) else {
+            self.errors
+                .push(format!("{}: serial set-up parameters missing", cb.id));
+            return;
+        };
+        let (pb99, run) = self.run;
+        self.write_at(cb, role, from, pr27, i64::from(to), "Pr27");
+        let v99 = (self.base(pb99) & !bit_value(pb99, run)) | bit_value(pb99, ext.at);
+        self.write_at(
+            cb,
+            role,
+            from,
+            pb99,
+            i64::from(v99),
+            "Pb99 (b99.6 = 1, PLC stopped)",
+        );
+        let v42 = self.base(pb42) | bit_value(pb42, reinit.at);
+        self.write_at(
+            cb,
+            role,
+            from,
+            pb42,
+            i64::from(v42),
+            "Pb42 (b42.3 = 1: re-initialise the line)",
+        );
+    }
+
+    // ------------------------------------------------------------------ finishing
+
+    /// Adds the case.
+    pub(crate) fn push(&mut self, cb: CaseB) {
+        let mut reqs: BTreeSet<String> = cb.explicit.iter().cloned().collect();
+        for s in cb.steps.iter().filter(|s| s.role != Role::Cleanup) {
+            reqs.extend(s.requirements.iter().cloned());
+        }
+        let reqs: Vec<String> = reqs.into_iter().filter(|r| self.known(r)).collect();
+        for r in &cb.explicit {
+            if !self.known(r) {
+                self.errors
+                    .push(format!("{}: unknown requirement {r}", cb.id));
+            }
+        }
+        let level = cb.level.unwrap_or_else(|| {
+            let levels: Vec<Level> = cb
+                .explicit
+                .iter()
+                .filter_map(|r| self.family.requirement(r))
+                .map(|r| r.level)
+                .collect();
+            if levels.is_empty() || levels.contains(&Level::Must) {
+                Level::Must
+            } else {
+                Level::Should
+            }
+        });
+        let info = CaseInfo {
+            id: cb.id,
+            family: FamilyId::Hpd,
+            requirements: reqs,
+            level,
+            description: cb.description,
+            steps: cb
+                .steps
+                .iter()
+                .map(|s| match s.role {
+                    Role::Setup => format!("setup: {}", s.text),
+                    Role::Check => s.text.clone(),
+                    Role::Cleanup => format!("cleanup: {}", s.text),
+                })
+                .collect(),
+        };
+        let case = HpdCase {
+            steps: cb.steps,
+            needs_power_cycle: cb.needs_power_cycle,
+            touched: cb.touched,
+        };
+        self.cases.push((info, case));
+    }
+}
+
+/// The raw value of `slot` as the signed or unsigned number of its parameter.
+pub(crate) fn sign_for(slot: Slot, raw: u32, family: &Family) -> i64 {
+    let signed = family
+        .parameter_at_address(u32::from(slot.addr))
+        .is_some_and(|p| p.data_type.signed());
+    if !signed {
+        return i64::from(raw);
+    }
+    let shift = 32 - 8 * u32::from(slot.size.clamp(1, 4));
+    i64::from(((raw << shift) as i32) >> shift)
+}
+
+/// The bit `at` as a mask over the raw value of `slot`.
+pub(crate) fn bit_value(slot: Slot, at: BitAddr) -> u32 {
+    let shift = 8 * u32::from(at.byte.saturating_sub(slot.addr));
+    u32::from(at.mask).checked_shl(shift).unwrap_or(0)
+}

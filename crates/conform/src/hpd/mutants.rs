@@ -1,0 +1,535 @@
+//! Mutation tests: the reference drive with one planted deviation (a wrapper around `Drive`,
+//! or an erratum reading other than the adopted one) as the device under test. Each mutant
+//! must fail at least the cases named for it, and every case it fails must cite one of the
+//! requirements the deviation breaks (no collateral failures). The score is printed.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use super::HpdSuite;
+use crate::case::Outcome;
+use crate::link::{Micros, SimDevice, SimLink};
+use crate::select::Pattern;
+use crate::suite::{Session, Settings};
+use drivespec_hpd::model::{Drive, DriveConfig, Output};
+use drivespec_hpd::params::Target;
+use drivespec_hpd::{decode, parse, AckEnd, Data, FrameRules, Message, MessageKind, Status};
+use drivespec_spec::{FamilyId, Readings, Spec};
+use std::sync::OnceLock;
+
+fn spec() -> &'static Spec {
+    static SPEC: OnceLock<Spec> = OnceLock::new();
+    SPEC.get_or_init(|| Spec::builtin().unwrap())
+}
+
+fn rules() -> FrameRules {
+    FrameRules::from_spec(spec()).unwrap()
+}
+
+/// The planted deviations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    ChecksumOffByOne,
+    AnswersBroadcasts,
+    IgnoresRanges,
+    WrongBitChangeByte,
+    AnswersForeignAddress,
+    IgnoresTimeout,
+    AckWithChecksum,
+    BigEndian,
+    NoStuffing,
+    ReadOnlyWritable,
+    PlcWritableWhileRunning,
+    /// An erratum reading instead of the adopted one.
+    Reading(&'static str, &'static str),
+}
+
+/// A drive with a deviation.
+#[derive(Clone)]
+struct Mutant {
+    inner: Drive,
+    kind: Kind,
+    rules: FrameRules,
+    /// Bytes held back by `IgnoresTimeout`.
+    held: Vec<u8>,
+    /// Extra outputs the wrapper adds.
+    extra: Vec<Output>,
+}
+
+impl Mutant {
+    fn new(kind: Kind) -> Mutant {
+        let mut readings = Readings::default();
+        if let Kind::Reading(option, reading) = kind {
+            readings
+                .choose(spec().family(FamilyId::Hpd), option, reading)
+                .unwrap();
+        }
+        let inner =
+            Drive::new(spec(), DriveConfig::commissioned(0).with_readings(readings)).unwrap();
+        Mutant {
+            inner,
+            kind,
+            rules: rules(),
+            held: Vec::new(),
+            extra: Vec::new(),
+        }
+    }
+
+    fn own(&self) -> u8 {
+        self.inner.line().map_or(0, |l| l.address)
+    }
+
+    /// The single message a chunk holds, if it is exactly one.
+    fn single(&self, bytes: &[u8]) -> Option<Message> {
+        match decode(&self.rules, bytes, AckEnd::NextByte) {
+            Ok(Status::Complete(d)) if d.len == bytes.len() => Some(d.message),
+            _ => None,
+        }
+    }
+
+    fn value_in_range(&self, p: &drivespec_spec::Parameter, v: i64) -> bool {
+        let family = spec().family(FamilyId::Hpd);
+        let mode = family
+            .parameter("Pr31")
+            .and_then(|m| self.inner.value(&Target::Param(m)).ok())
+            .unwrap_or(0);
+        let range = p
+            .modes
+            .iter()
+            .find(|e| e.modes.contains(&(mode as u32)))
+            .and_then(|e| e.range.clone())
+            .or_else(|| family.resolve(p, None).range);
+        range.is_none_or(|r| r.contains(v))
+    }
+
+    /// Writes a value as a keypad would, when the deviation says the drive takes it.
+    fn force(&mut self, now: Micros, par: u8, data: &Data) {
+        let family = spec().family(FamilyId::Hpd);
+        let Some(p) = family.parameter_at_address(u32::from(par)) else {
+            return;
+        };
+        if p.address != Some(u32::from(par)) || p.size != Some(u32::from(data.len())) {
+            return;
+        }
+        if family.bitfields_of(&p.id).next().is_some() {
+            return;
+        }
+        let t = Target::Param(p);
+        let v = t.value(data);
+        let take = match self.kind {
+            Kind::IgnoresRanges => p.access.writable() && !self.value_in_range(p, v),
+            Kind::ReadOnlyWritable => !p.access.writable(),
+            _ => false,
+        };
+        if take {
+            let _ = self.inner.set_value(now, &t, v);
+        }
+    }
+
+    fn rx(&mut self, now: Micros, bytes: &[u8]) {
+        let own = self.own();
+        let msg = self.single(bytes);
+        match (self.kind, msg) {
+            (
+                Kind::WrongBitChangeByte,
+                Some(Message::BitChange {
+                    addr,
+                    par,
+                    mask,
+                    value,
+                }),
+            ) => {
+                let family = spec().family(FamilyId::Hpd);
+                let high = family
+                    .parameter_at_address(u32::from(par))
+                    .is_some_and(|p| p.address.is_some_and(|a| a + 1 == u32::from(par)));
+                if high {
+                    let m = Message::BitChange {
+                        addr,
+                        par: par - 1,
+                        mask,
+                        value,
+                    };
+                    self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                    return;
+                }
+            }
+            (Kind::AnswersForeignAddress, Some(m))
+                if m.is_request() && m.kind() != MessageKind::Broadcast && m.addr() != own =>
+            {
+                let m = match m {
+                    Message::ReadParam { lun, par, .. } => Message::ReadParam {
+                        addr: own,
+                        lun,
+                        par,
+                    },
+                    Message::ReadPlc { lun, par, .. } => Message::ReadPlc {
+                        addr: own,
+                        lun,
+                        par,
+                    },
+                    Message::WriteParam { par, data, .. } => Message::WriteParam {
+                        addr: own,
+                        par,
+                        data,
+                    },
+                    Message::WritePlc { par, data, .. } => Message::WritePlc {
+                        addr: own,
+                        par,
+                        data,
+                    },
+                    Message::BitChange {
+                        par, mask, value, ..
+                    } => Message::BitChange {
+                        addr: own,
+                        par,
+                        mask,
+                        value,
+                    },
+                    other => other,
+                };
+                self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                return;
+            }
+            (Kind::AnswersBroadcasts, Some(Message::Broadcast { .. })) => {
+                self.inner.handle_rx(now, bytes);
+                let ack = Message::Ack { addr: own }.to_bytes(&self.rules).unwrap();
+                self.extra.push(Output::Transmit {
+                    at: now,
+                    bytes: ack,
+                });
+                return;
+            }
+            (
+                Kind::IgnoresRanges | Kind::ReadOnlyWritable,
+                Some(Message::WriteParam { addr, par, data }),
+            ) if addr == own => {
+                self.inner.handle_rx(now, bytes);
+                self.force(now, par, &data);
+                return;
+            }
+            (
+                Kind::IgnoresRanges | Kind::ReadOnlyWritable,
+                Some(Message::Broadcast { par, data }),
+            ) => {
+                self.inner.handle_rx(now, bytes);
+                self.force(now, par, &data);
+                return;
+            }
+            (Kind::PlcWritableWhileRunning, Some(Message::WritePlc { addr, .. }))
+                if addr == own =>
+            {
+                let family = spec().family(FamilyId::Hpd);
+                let run = Target::parse(family, "b99.13").unwrap();
+                let running = self.inner.value(&run).unwrap_or(0);
+                let _ = self.inner.set_value(now, &run, 0);
+                self.inner.handle_rx(now, bytes);
+                let _ = self.inner.set_value(now, &run, running);
+                return;
+            }
+            _ => {}
+        }
+        if self.kind == Kind::IgnoresTimeout {
+            // Frames are only delivered once complete: a pause never drops them.
+            self.held.extend_from_slice(bytes);
+            loop {
+                match decode(&self.rules, &self.held, AckEnd::NextByte) {
+                    Ok(Status::Complete(d)) => {
+                        let frame: Vec<u8> = self.held.drain(..d.len).collect();
+                        self.inner.handle_rx(now, &frame);
+                    }
+                    Ok(Status::Incomplete { .. }) => break,
+                    Err(e) => {
+                        let junk: Vec<u8> =
+                            self.held.drain(..e.skip.min(self.held.len())).collect();
+                        self.inner.handle_rx(now, &junk);
+                    }
+                }
+                if self.held.is_empty() {
+                    break;
+                }
+            }
+            return;
+        }
+        self.inner.handle_rx(now, bytes);
+    }
+
+    /// The deviation applied to what the drive sends.
+    fn tx(&self, bytes: Vec<u8>) -> Vec<u8> {
+        let stx = self.rules.stx;
+        let stuffed = |fields: &[u8], chk: u8| {
+            let mut out = vec![stx];
+            for b in fields.iter().copied().chain([chk]) {
+                out.push(b);
+                if b == stx {
+                    out.push(self.rules.stuff);
+                }
+            }
+            out
+        };
+        let Ok(msg) = parse(&self.rules, &bytes) else {
+            return bytes;
+        };
+        match (self.kind, msg) {
+            (Kind::ChecksumOffByOne, Message::Response { addr, par, data }) => {
+                let fields: Vec<u8> = [self.rules.join(1, addr), data.len(), par]
+                    .into_iter()
+                    .chain(data.as_slice().iter().copied())
+                    .collect();
+                let sum = fields.iter().fold(0u8, |s, b| s.wrapping_add(*b));
+                stuffed(&fields, sum.wrapping_add(1))
+            }
+            (Kind::BigEndian, Message::Response { addr, par, data }) if data.len() > 1 => {
+                let mut rev = data.as_slice().to_vec();
+                rev.reverse();
+                let m = Message::Response {
+                    addr,
+                    par,
+                    data: Data::new(&rev).unwrap(),
+                };
+                m.to_bytes(&self.rules).unwrap()
+            }
+            (Kind::AckWithChecksum, Message::Ack { .. }) => {
+                let mut b = bytes.clone();
+                let chk = b.get(1).copied().unwrap_or(0);
+                b.push(chk);
+                b
+            }
+            (Kind::NoStuffing, _) => {
+                let mut out = Vec::new();
+                let mut prev_stx = false;
+                for (i, b) in bytes.iter().enumerate() {
+                    if prev_stx && *b == self.rules.stuff && i > 1 {
+                        prev_stx = false;
+                        continue;
+                    }
+                    prev_stx = *b == stx && i > 0;
+                    out.push(*b);
+                }
+                out
+            }
+            _ => bytes,
+        }
+    }
+}
+
+impl SimDevice for Mutant {
+    fn handle_rx(&mut self, now: Micros, bytes: &[u8]) {
+        self.rx(now, bytes);
+    }
+    fn advance(&mut self, now: Micros) {
+        self.inner.advance(now);
+    }
+    fn poll_output(&mut self) -> Option<Output> {
+        if !self.extra.is_empty() {
+            return Some(self.extra.remove(0));
+        }
+        match self.inner.poll_output()? {
+            Output::Transmit { at, bytes } => Some(Output::Transmit {
+                at,
+                bytes: self.tx(bytes),
+            }),
+            o => Some(o),
+        }
+    }
+    fn power_cycle(&mut self, now: Micros) {
+        self.held.clear();
+        self.inner.power_cycle(now);
+    }
+    fn clone_box(&self) -> Box<dyn SimDevice> {
+        Box::new(self.clone())
+    }
+}
+
+struct Case {
+    name: &'static str,
+    kind: Kind,
+    /// Requirements the deviation breaks: every failing case must cite one.
+    breaks: Vec<String>,
+    /// Cases that must fail.
+    must_fail: &'static [&'static str],
+}
+
+fn mutants() -> Vec<Case> {
+    let read_only: Vec<String> = spec()
+        .family(FamilyId::Hpd)
+        .requirements
+        .iter()
+        .filter(|r| r.text.contains("read-only"))
+        .map(|r| r.id.clone())
+        .collect();
+    let v = |ids: &[&str]| ids.iter().map(|s| (*s).to_owned()).collect::<Vec<_>>();
+    vec![
+        Case {
+            name: "checksum off by one",
+            kind: Kind::ChecksumOffByOne,
+            breaks: v(&["HPD-FRAME-009"]),
+            must_fail: &["hpd/frame/read-parameter", "hpd/plc/read-area"],
+        },
+        Case {
+            name: "answers broadcasts",
+            kind: Kind::AnswersBroadcasts,
+            breaks: v(&["HPD-SERIAL-013"]),
+            must_fail: &["hpd/frame/broadcast", "hpd/broadcast/dword"],
+        },
+        Case {
+            name: "ignores ranges",
+            kind: Kind::IgnoresRanges,
+            breaks: v(&["HPD-PAR-009"]),
+            must_fail: &[
+                "hpd/param/Pr33/above-max",
+                "hpd/param/Pr50/mode-12/above-max",
+                "hpd/broadcast/out-of-range",
+            ],
+        },
+        Case {
+            name: "wrong bit-change byte",
+            kind: Kind::WrongBitChangeByte,
+            breaks: v(&["HPD-FRAME-018"]),
+            must_fail: &["hpd/bit/b90.8/set", "hpd/bit/b40.9/clear"],
+        },
+        Case {
+            name: "DIV remainder lost",
+            kind: Kind::Reading("div-remainder", "quotient32"),
+            breaks: v(&["HPD-PLC-025"]),
+            must_fail: &["hpd/plc/vector/plc-div-79-77-80-dword"],
+        },
+        Case {
+            name: "answers a foreign address",
+            kind: Kind::AnswersForeignAddress,
+            breaks: v(&["HPD-SERIAL-003"]),
+            must_fail: &[
+                "hpd/frame/foreign-address/5",
+                "hpd/frame/foreign-address-write",
+            ],
+        },
+        Case {
+            name: "ignores the time-out",
+            kind: Kind::IgnoresTimeout,
+            breaks: v(&["HPD-BAUD-003", "HPD-FRAME-020"]),
+            must_fail: &["hpd/frame/timeout-split", "hpd/baud/code-0"],
+        },
+        Case {
+            name: "acknowledge with checksum",
+            kind: Kind::AckWithChecksum,
+            breaks: v(&["HPD-FRAME-011"]),
+            must_fail: &["hpd/frame/write-parameter"],
+        },
+        Case {
+            name: "big-endian data",
+            kind: Kind::BigEndian,
+            breaks: v(&["HPD-SERIAL-016"]),
+            must_fail: &["hpd/frame/read-lun-2", "hpd/vector/serial-case-8"],
+        },
+        Case {
+            name: "answers not stuffed",
+            kind: Kind::NoStuffing,
+            breaks: v(&["HPD-FRAME-003"]),
+            must_fail: &[
+                "hpd/frame/stuffing/response-checksum",
+                "hpd/vector/serial-case-1",
+            ],
+        },
+        Case {
+            name: "read-only parameters writable",
+            kind: Kind::ReadOnlyWritable,
+            breaks: read_only,
+            must_fail: &["hpd/param/Pr25/write-refused"],
+        },
+        Case {
+            name: "PLC writable while running",
+            kind: Kind::PlcWritableWhileRunning,
+            breaks: v(&["HPD-BIT-99-13"]),
+            must_fail: &["hpd/plc/upload-while-running"],
+        },
+        Case {
+            name: "command bits stay set",
+            kind: Kind::Reading("command-self-clear", "latched"),
+            breaks: v(&["HPD-CMD-SELF-CLEAR"]),
+            must_fail: &["hpd/cmd/b99.10/self-clear"],
+        },
+        Case {
+            name: "security only on the keypad",
+            kind: Kind::Reading("b99-7-scope", "keypad-only"),
+            breaks: v(&["HPD-BIT-99-7"]),
+            must_fail: &["hpd/cmd/b99.7/blocks-writes"],
+        },
+        Case {
+            name: "Pr31 takes any byte",
+            kind: Kind::Reading("pr31-range", "byte"),
+            breaks: v(&["HPD-PAR-009"]),
+            must_fail: &["hpd/param/Pr31/gap-3", "hpd/param/Pr31/above-max"],
+        },
+        Case {
+            name: "b99.3 set for non-zero results",
+            kind: Kind::Reading("b99-3", "nonzero"),
+            breaks: v(&[
+                "HPD-PLC-021",
+                "HPD-BIT-99-3",
+                "HPD-PLC-013",
+                "HPD-PLC-017",
+                "HPD-PLC-025",
+                "HPD-PLC-015",
+            ]),
+            must_fail: &["hpd/plc/vector/plc-div-79-77-80-dword"],
+        },
+    ]
+}
+
+#[test]
+fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let mut caught = 0;
+    let mut report = Vec::new();
+    let mut problems = Vec::new();
+    let all = mutants();
+    for m in &all {
+        let link = SimLink::new(format!("mutant: {}", m.name), Box::new(Mutant::new(m.kind)));
+        let mut session = suite.session(Box::new(link));
+        let mut failed = Vec::new();
+        for (i, info) in suite.infos.iter().enumerate() {
+            if let Outcome::Fail(f) = session.run(i).outcome {
+                let cites: Vec<String> = f
+                    .requirements
+                    .iter()
+                    .map(|r| r.id.clone())
+                    .chain(info.requirements.iter().cloned())
+                    .collect();
+                if !m.breaks.iter().any(|b| cites.contains(b)) {
+                    problems.push(format!(
+                        "{}: collateral failure {} ({})",
+                        m.name, info.id, f.message
+                    ));
+                }
+                failed.push(info.id.clone());
+            }
+        }
+        for want in m.must_fail {
+            let p = Pattern::new(want).unwrap();
+            if !failed.iter().any(|id| p.matches(id)) {
+                problems.push(format!("{}: {want} did not fail", m.name));
+            }
+        }
+        if !failed.is_empty() {
+            caught += 1;
+        }
+        report.push(format!(
+            "{:<34} breaks {:<40} fails {:>3} case(s)",
+            m.name,
+            m.breaks.join(", ").chars().take(40).collect::<String>(),
+            failed.len()
+        ));
+    }
+    println!("HPD mutants:\n{}", report.join("\n"));
+    println!(
+        "mutation score: {caught}/{} = {:.0} %",
+        all.len(),
+        100.0 * caught as f64 / all.len() as f64
+    );
+    assert!(all.len() >= 12);
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert_eq!(caught, all.len());
+}

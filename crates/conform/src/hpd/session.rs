@@ -1,0 +1,636 @@
+//! Running HPD cases: every step goes to the device under test and to the reference drive
+//! (the oracle), and their answers are compared (differential verdict).
+//!
+//! The answer window of a request is the message time-out of the Pr26 code the reference is
+//! using, plus its answer delay (Pr26 = 4), the line time of the longest answer and the
+//! transport's slack. A step fails on any difference: other bytes, an answer where the
+//! reference is silent or silence where it answers, or an answer sooner than the reference's
+//! delay allows. The first failing step ends the judged part of a case; its clean-up steps
+//! still run. On a transport that cannot reset the device, the reference is brought back in
+//! line after a failure by reading the parameters the case touched from the device.
+
+use super::step::{Action, Compare, HpdCase, Step};
+use super::HpdSuite;
+use crate::case::{Answer, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::link::{concat, Chunk, Link, LinkError, Micros, Recovered};
+use crate::suite::Session;
+use drivespec_hpd::explain::explain;
+use drivespec_hpd::model::{Drive, Output};
+use drivespec_hpd::params::Target;
+use drivespec_hpd::{LineDecoder, LineEvent, Message};
+use drivespec_spec::hex::to_hex;
+
+/// A session on one device under test.
+pub struct HpdSession<'a, 's> {
+    suite: &'a HpdSuite<'s>,
+    link: Box<dyn Link>,
+    oracle: Drive,
+    /// Link time at which the oracle's clock was 0.
+    offset: Micros,
+    /// Extra time allowed for answers (µs).
+    slack: Micros,
+    /// Time to wait for trailing bytes after a complete answer on real transports (µs).
+    settle: Micros,
+}
+
+/// A judged step's (match, explanation), nothing to judge, or a transport error with the
+/// reference's answer.
+type StepResult = Result<Option<(bool, String)>, (LinkError, Vec<Chunk>)>;
+
+/// What the device and the reference did in one step.
+struct Observed {
+    expected: Vec<Chunk>,
+    got: Vec<Chunk>,
+    t0: Micros,
+    /// Late bytes dropped before the request.
+    late: Vec<u8>,
+}
+
+impl<'a, 's> HpdSession<'a, 's> {
+    pub(crate) fn new(suite: &'a HpdSuite<'s>, link: Box<dyn Link>, slack: Micros) -> Self {
+        let virtual_time = link.caps().virtual_time;
+        HpdSession {
+            suite,
+            link,
+            oracle: suite.baseline.clone(),
+            offset: 0,
+            slack,
+            settle: if virtual_time { 0 } else { slack.min(3_000) },
+        }
+    }
+
+    fn reset_oracle(&mut self) {
+        self.oracle = self.suite.baseline.clone();
+        self.offset = self.link.now();
+    }
+
+    fn otime(&self, t: Micros) -> Micros {
+        t.saturating_sub(self.offset)
+    }
+
+    /// Message time-out and answer delay in force at the reference (µs).
+    fn line_times(&self) -> (Micros, Micros, u32) {
+        match self.oracle.line() {
+            Some(l) => (l.timeout_us, l.answer_delay_us, l.bps.max(1)),
+            None => {
+                let worst = self
+                    .suite
+                    .protocol()
+                    .baud_rates
+                    .iter()
+                    .map(|b| u64::from(b.timeout_ms) * 1000)
+                    .max()
+                    .unwrap_or(512_000);
+                (worst, 0, 600)
+            }
+        }
+    }
+
+    /// The answer window after a request.
+    fn window(&self) -> Micros {
+        let (timeout, delay, bps) = self.line_times();
+        let bits = u64::from(self.suite.protocol().character.bits_per_char.max(1));
+        let answer = (drivespec_hpd::MAX_FRAME as u64) * bits * 1_000_000 / u64::from(bps);
+        timeout + delay + answer + self.slack
+    }
+
+    /// Drains the reference's line output; reference time `o_base` is link time `t_base`.
+    fn oracle_output(&mut self, o_base: Micros, t_base: Micros) -> Vec<Chunk> {
+        let mut out = Vec::new();
+        while let Some(o) = self.oracle.poll_output() {
+            if let Output::Transmit { at, bytes } = o {
+                out.push(Chunk {
+                    at: at.saturating_sub(o_base).saturating_add(t_base),
+                    bytes,
+                });
+            }
+        }
+        out
+    }
+
+    /// The reference time for link time `t`: never behind the reference's own clock.
+    fn oracle_now(&self, t: Micros) -> Micros {
+        self.otime(t).max(self.oracle.now())
+    }
+
+    /// Sends `bytes` to both and collects the answers within the window.
+    fn exchange(&mut self, bytes: &[u8]) -> Result<Observed, (LinkError, Vec<Chunk>)> {
+        let late = self.drain_late();
+        let window = self.window();
+        let (_, delay, _) = self.line_times();
+        let t0 = self.link.now();
+        let o0 = self.oracle_now(t0);
+        self.oracle.handle_rx(o0, bytes);
+        // Only as far as the answer (and its delay) needs: the reference must not run ahead
+        // of the device's clock.
+        self.oracle.advance(o0 + delay + 1);
+        let expected = self.oracle_output(o0, t0);
+        let want = concat(&expected).len();
+        if let Err(e) = self.link.send(bytes) {
+            return Err((e, expected));
+        }
+        let mut enough = |b: &[u8]| want > 0 && b.len() >= want;
+        let mut got = match self.link.recv(t0 + window, &mut enough) {
+            Ok(g) => g,
+            Err(e) => return Err((e, expected)),
+        };
+        if want > 0 && self.settle > 0 && concat(&got).len() >= want {
+            let until = self.link.now() + self.settle;
+            match self.link.recv(until, &mut |_| false) {
+                Ok(more) => got.extend(more),
+                Err(e) => return Err((e, expected)),
+            }
+        }
+        Ok(Observed {
+            expected,
+            got,
+            t0,
+            late,
+        })
+    }
+
+    /// Bytes that came after the last answer window (a late answer, already judged where
+    /// it belonged): dropped so they are not taken for the next answer.
+    fn drain_late(&mut self) -> Vec<u8> {
+        if self.link.caps().virtual_time {
+            return Vec::new();
+        }
+        let now = self.link.now();
+        self.link
+            .recv(now + 1, &mut |_| false)
+            .map(|c| concat(&c))
+            .unwrap_or_default()
+    }
+
+    /// Listens for `us` on both.
+    fn listen(&mut self, us: Micros) -> Result<Observed, (LinkError, Vec<Chunk>)> {
+        let t0 = self.link.now();
+        let o0 = self.oracle_now(t0);
+        self.oracle.advance(o0 + us);
+        let expected = self.oracle_output(o0, t0);
+        match self.link.recv(t0 + us, &mut |_| false) {
+            Ok(got) => Ok(Observed {
+                expected,
+                got,
+                t0,
+                late: Vec::new(),
+            }),
+            Err(e) => Err((e, expected)),
+        }
+    }
+
+    /// Reads the touched parameters from the device into the reference (after a failure on
+    /// a transport that cannot reset the device).
+    fn resync(&mut self, case: &HpdCase) {
+        let family = self.suite.family();
+        let addr = self.suite.settings.address;
+        for slot in &case.touched {
+            let Some(p) = family.parameter_at_address(u32::from(slot.addr)) else {
+                continue;
+            };
+            let msg = Message::ReadParam {
+                addr,
+                lun: slot.size,
+                par: slot.addr,
+            };
+            let Ok(bytes) = msg.to_bytes(&self.suite.rules) else {
+                continue;
+            };
+            let window = self.window();
+            let t0 = self.link.now();
+            if self.link.send(&bytes).is_err() {
+                return;
+            }
+            let Ok(got) = self.link.recv(t0 + window, &mut |b| b.len() >= 5) else {
+                return;
+            };
+            let got = concat(&got);
+            if let Ok(Message::Response { par, data, .. }) =
+                drivespec_hpd::parse(&self.suite.rules, &got)
+            {
+                if par == slot.addr && data.len() == slot.size {
+                    let target = Target::Param(p);
+                    let t = self.link.now();
+                    let now = self.oracle_now(t);
+                    let _ = self.oracle.set_value(now, &target, target.value(&data));
+                    let _ = self.oracle_output(now, t);
+                }
+            }
+        }
+    }
+
+    /// Bytes in words: the frames in them, explained.
+    fn words(&self, bytes: &[u8], request: Option<&Message>) -> String {
+        if bytes.is_empty() {
+            return "silence".to_owned();
+        }
+        let suite = self.suite;
+        let mut parts = Vec::new();
+        let mut dec = LineDecoder::new(suite.rules.clone());
+        let mut sink = |e: LineEvent| match e {
+            LineEvent::Frame(f) => {
+                let x = explain(
+                    suite.family(),
+                    &suite.rules,
+                    Some(&suite.codec),
+                    &f.message,
+                    request,
+                );
+                parts.push(x.summary);
+            }
+            LineEvent::Discarded(d) => {
+                parts.push(format!(
+                    "{} byte(s) that are not a message ({})",
+                    d.len, d.reason
+                ));
+            }
+        };
+        dec.feed(bytes, None, &mut sink);
+        dec.finish(&mut sink);
+        parts.join("; ")
+    }
+
+    fn answer(&self, chunks: &[Chunk], t0: Micros, request: Option<&Message>) -> Answer {
+        let bytes = concat(chunks);
+        if bytes.is_empty() {
+            return Answer::silence();
+        }
+        Answer {
+            hex: to_hex(&bytes),
+            text: self.words(&bytes, request),
+            delay_us: chunks.first().map(|c| c.at.saturating_sub(t0)),
+        }
+    }
+
+    /// Requirements the reference's answer `expected` shows (manual 4.1): the answer form,
+    /// its checksum, byte order and stuffing.
+    fn answer_reqs(&self, expected: &[u8]) -> Vec<String> {
+        let rules = &self.suite.rules;
+        let mut out: Vec<&str> = Vec::new();
+        let mut dec = LineDecoder::new(rules.clone());
+        let mut sink = |e: LineEvent| {
+            if let LineEvent::Frame(f) = e {
+                match f.message {
+                    Message::Ack { .. } => out.push("HPD-FRAME-011"),
+                    Message::Response { data, .. } => {
+                        out.extend(["HPD-FRAME-010", "HPD-FRAME-009", "HPD-SERIAL-017"]);
+                        if data.len() > 1 {
+                            out.push("HPD-SERIAL-016");
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        };
+        dec.feed(expected, None, &mut sink);
+        dec.finish(&mut sink);
+        if expected
+            .windows(2)
+            .skip(1)
+            .any(|w| w == [rules.stx, rules.stuff])
+        {
+            out.push("HPD-FRAME-003");
+        }
+        out.into_iter().map(str::to_owned).collect()
+    }
+
+    fn requirement_refs(
+        &self,
+        case_reqs: &[String],
+        step: Option<&Step>,
+        expected: &[u8],
+    ) -> Vec<RequirementRef> {
+        let family = self.suite.family();
+        let mut ids: Vec<String> = step.map(|s| s.requirements.clone()).unwrap_or_default();
+        for r in self
+            .answer_reqs(expected)
+            .into_iter()
+            .chain(case_reqs.iter().cloned())
+        {
+            if !ids.contains(&r) {
+                ids.push(r);
+            }
+        }
+        ids.into_iter()
+            .filter_map(|id| family.requirement(&id))
+            .map(|r| RequirementRef {
+                id: r.id.clone(),
+                level: r.level,
+                text: r.text.clone(),
+            })
+            .collect()
+    }
+}
+
+/// Whether the device's bytes match the reference's under `compare`.
+fn matches(rules: &drivespec_hpd::FrameRules, compare: Compare, exp: &[u8], got: &[u8]) -> bool {
+    if exp == got {
+        return true;
+    }
+    let (Compare::Mask(_) | Compare::Near { .. }) = compare else {
+        return false;
+    };
+    let (Ok(a), Ok(b)) = (
+        drivespec_hpd::parse(rules, exp),
+        drivespec_hpd::parse(rules, got),
+    ) else {
+        return false;
+    };
+    match (a, b) {
+        (
+            Message::Response {
+                addr: aa,
+                par: ap,
+                data: ad,
+            },
+            Message::Response {
+                addr: ba,
+                par: bp,
+                data: bd,
+            },
+        ) if aa == ba && ap == bp && ad.len() == bd.len() => match compare {
+            Compare::Mask(m) => ad.unsigned() & m == bd.unsigned() & m,
+            Compare::Near { tolerance } => {
+                (i64::from(ad.unsigned()) - i64::from(bd.unsigned())).abs() <= tolerance
+            }
+            Compare::Exact => false,
+        },
+        _ => false,
+    }
+}
+
+impl Session for HpdSession<'_, '_> {
+    fn describe(&self) -> String {
+        self.link.describe()
+    }
+
+    fn run(&mut self, index: usize) -> CaseRun {
+        let suite = self.suite;
+        let (Some(info), Some(case)) = (suite.infos.get(index), suite.cases.get(index)) else {
+            return CaseRun {
+                outcome: Outcome::Skip {
+                    reason: format!("no case {index}"),
+                },
+                evidence: Vec::new(),
+                elapsed_us: 0,
+            };
+        };
+        let caps = self.link.caps();
+        if case.needs_power_cycle && !caps.power_cycle {
+            return CaseRun {
+                outcome: Outcome::Skip {
+                    reason: "needs the device switched off and on, which this transport cannot do (only sim can)".to_owned(),
+                },
+                evidence: Vec::new(),
+                elapsed_us: 0,
+            };
+        }
+        let start = self.link.now();
+        if caps.reset {
+            match self.link.reset() {
+                Ok(true) => self.reset_oracle(),
+                Ok(false) => {}
+                Err(e) => {
+                    return CaseRun {
+                        outcome: Outcome::Fail(Failure {
+                            step: None,
+                            message: format!("transport: {e}"),
+                            expected: "a device in its start state".to_owned(),
+                            got: e.to_string(),
+                            requirements: Vec::new(),
+                        }),
+                        evidence: Vec::new(),
+                        elapsed_us: 0,
+                    }
+                }
+            }
+        }
+        let mut evidence: Vec<Record> = Vec::new();
+        let mut failure: Option<Failure> = None;
+        let mut broken = false;
+        let mut last_request: Option<Message> = None;
+        for (i, step) in case.steps.iter().enumerate() {
+            let judged = step.role != Role::Cleanup;
+            if judged && failure.is_some() {
+                continue;
+            }
+            if broken {
+                break;
+            }
+            let at_us = self.link.now();
+            let mut rec = Record {
+                step: i,
+                role: step.role,
+                action: step.text.clone(),
+                at_us,
+                sent: None,
+                sent_text: None,
+                expected: None,
+                got: None,
+                ok: None,
+                note: None,
+            };
+            let result: StepResult = match &step.action {
+                Action::Exchange {
+                    bytes,
+                    compare,
+                    silence_ok,
+                    golden,
+                } => {
+                    let request = drivespec_hpd::parse(&suite.rules, bytes).ok();
+                    rec.sent = Some(to_hex(bytes));
+                    rec.sent_text = Some(self.words(bytes, None));
+                    last_request = request;
+                    match self.exchange(bytes) {
+                        Ok(obs) => {
+                            let exp = concat(&obs.expected);
+                            let got = concat(&obs.got);
+                            let ea = self.answer(&obs.expected, obs.t0, request.as_ref());
+                            let ga = self.answer(&obs.got, obs.t0, request.as_ref());
+                            let mut ok = matches(&suite.rules, *compare, &exp, &got)
+                                || (*silence_ok && got.is_empty());
+                            let mut why = format!("expected {}, got {}", show(&ea), show(&ga));
+                            if let (true, Some(ed), Some(gd)) =
+                                (ok && !got.is_empty(), ea.delay_us, ga.delay_us)
+                            {
+                                // A delayed answer (Pr26 = 4) must not come early.
+                                if ed >= 5_000 && gd + ed / 5 < ed {
+                                    ok = false;
+                                    why = format!("the answer came after {gd} µs; the reference answers after {ed} µs (answer delay)");
+                                }
+                            }
+                            if let Some(g) = golden {
+                                if g != &exp {
+                                    ok = false;
+                                    why = format!(
+                                        "the reference model disagrees with the golden vector: vector {}, model {}",
+                                        if g.is_empty() { "silence".to_owned() } else { to_hex(g) },
+                                        show(&ea)
+                                    );
+                                }
+                            }
+                            rec.note = match compare {
+                                Compare::Exact => None,
+                                Compare::Mask(m) => Some(format!("data compared under mask {m:#06x} (bits the drive sets itself are not compared)")),
+                                Compare::Near { tolerance } => Some(format!("data compared within ±{tolerance}")),
+                            };
+                            if *silence_ok {
+                                rec.note = Some(
+                                    "silence is also accepted (vector result: acceptable)"
+                                        .to_owned(),
+                                );
+                            }
+                            if !obs.late.is_empty() {
+                                let n = format!(
+                                    "{} late byte(s) dropped before the request: {}",
+                                    obs.late.len(),
+                                    to_hex(&obs.late)
+                                );
+                                rec.note = Some(match rec.note.take() {
+                                    Some(x) => format!("{x}; {n}"),
+                                    None => n,
+                                });
+                            }
+                            rec.expected = Some(ea);
+                            rec.got = Some(ga);
+                            Ok(Some((ok, why)))
+                        }
+                        Err(e) => Err(e),
+                    }
+                }
+                Action::Send { bytes } => {
+                    rec.sent = Some(to_hex(bytes));
+                    let t = self.link.now();
+                    let o = self.oracle_now(t);
+                    self.oracle.handle_rx(o, bytes);
+                    match self.link.send(bytes) {
+                        Ok(()) => Ok(None),
+                        Err(e) => Err((e, Vec::new())),
+                    }
+                }
+                Action::Listen { .. } | Action::ListenTimeout | Action::ListenHalfTimeout => {
+                    let (timeout, _, _) = self.line_times();
+                    let us = match step.action {
+                        Action::Listen { us } => us,
+                        Action::ListenTimeout => timeout + self.slack.max(1_000),
+                        _ => timeout / 2,
+                    };
+                    rec.note = Some(format!("listened {us} µs"));
+                    match self.listen(us) {
+                        Ok(obs) => {
+                            let ea = self.answer(&obs.expected, obs.t0, last_request.as_ref());
+                            let ga = self.answer(&obs.got, obs.t0, last_request.as_ref());
+                            let ok = ea.hex == ga.hex;
+                            let why = format!(
+                                "expected {} while listening, got {}",
+                                show(&ea),
+                                show(&ga)
+                            );
+                            rec.expected = Some(ea);
+                            rec.got = Some(ga);
+                            Ok(Some((ok, why)))
+                        }
+                        Err(e) => Err(e),
+                    }
+                }
+                Action::PowerCycle => match self.link.power_cycle() {
+                    Ok(_) => {
+                        let t = self.link.now();
+                        let o = self.oracle_now(t);
+                        self.oracle.power_cycle(o);
+                        let _ = self.oracle_output(o, t);
+                        Ok(None)
+                    }
+                    Err(e) => Err((e, Vec::new())),
+                },
+                Action::BitRate => {
+                    let bps = self.oracle.line().map_or(0, |l| l.bps);
+                    rec.note = Some(format!("{bps} b/s"));
+                    match self.link.set_bit_rate(bps) {
+                        Ok(()) => Ok(None),
+                        Err(e) => Err((e, Vec::new())),
+                    }
+                }
+            };
+            match result {
+                Ok(Some((ok, why))) => {
+                    if judged {
+                        rec.ok = Some(ok);
+                        if !ok {
+                            let exp_bytes = rec
+                                .expected
+                                .as_ref()
+                                .and_then(|a| drivespec_spec::hex::parse_hex(&a.hex).ok())
+                                .unwrap_or_default();
+                            failure = Some(Failure {
+                                step: Some(evidence.len()),
+                                message: format!("step {i} ({}): {why}", step.text),
+                                expected: rec.expected.as_ref().map(show).unwrap_or_default(),
+                                got: rec.got.as_ref().map(show).unwrap_or_default(),
+                                requirements: self.requirement_refs(
+                                    &info.requirements,
+                                    Some(step),
+                                    &exp_bytes,
+                                ),
+                            });
+                        }
+                    } else {
+                        rec.note = Some(match &rec.note {
+                            Some(n) => format!("{n}; clean-up, not judged"),
+                            None => "clean-up, not judged".to_owned(),
+                        });
+                    }
+                }
+                Ok(None) => {}
+                Err((e, expected)) => {
+                    let ea = self.answer(&expected, at_us, last_request.as_ref());
+                    rec.expected = Some(ea.clone());
+                    rec.ok = Some(false);
+                    rec.note = Some(format!("transport: {e}"));
+                    if failure.is_none() {
+                        failure = Some(Failure {
+                            step: Some(evidence.len()),
+                            message: format!("step {i} ({}): transport: {e}", step.text),
+                            expected: show(&ea),
+                            got: e.to_string(),
+                            requirements: self.requirement_refs(
+                                &info.requirements,
+                                Some(step),
+                                &concat(&expected),
+                            ),
+                        });
+                    }
+                    broken = true;
+                    match self.link.recover() {
+                        Ok(Recovered::Fresh) => self.reset_oracle(),
+                        Ok(Recovered::Same) => {}
+                        Err(e2) => {
+                            rec.note = Some(format!("transport: {e}; restart failed: {e2}"));
+                        }
+                    }
+                }
+            }
+            evidence.push(rec);
+        }
+        if failure.is_some() && !broken && !caps.reset {
+            self.resync(case);
+        }
+        let elapsed_us = self.link.now().saturating_sub(start);
+        CaseRun {
+            outcome: match failure {
+                Some(f) => Outcome::Fail(f),
+                None => Outcome::Pass,
+            },
+            evidence,
+            elapsed_us,
+        }
+    }
+}
+
+fn show(a: &Answer) -> String {
+    if a.is_silence() {
+        "silence".to_owned()
+    } else {
+        format!("{} ({})", a.hex, a.text)
+    }
+}

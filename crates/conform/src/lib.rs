@@ -1,0 +1,25 @@
+//! The drivespec conformance runner: cases generated from the spec, a differential oracle
+//! (the family's reference model fed the same inputs as the device under test), transports to
+//! the device, and reports (JUnit XML, JSON, self-contained HTML).
+//!
+//! - [`suite`]: the [`suite::Suite`]/[`suite::Session`] traits a family implements; HPD in
+//!   [`hpd`].
+//! - [`link`]: the transports (`sim`, `serial`, `tcp`, `exec`) behind [`link::Link`].
+//! - [`runner`]: selection, expectations, progress, reports; [`runner::run`] is what the CLI
+//!   calls.
+//! - [`report`]: the report model and its renderings (schema in `REPORTS.md`).
+//!
+//! Nothing here panics on any input or device behaviour; every wait is bounded by a deadline.
+#![forbid(unsafe_code)]
+
+pub mod case;
+pub mod dut;
+pub mod hpd;
+pub mod link;
+pub mod report;
+mod rng;
+pub mod runner;
+pub mod select;
+pub mod suite;
+
+pub use runner::{run, ConformError, Options, Progress, Summary};

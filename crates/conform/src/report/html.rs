@@ -1,0 +1,221 @@
+//! A self-contained HTML report (no scripts, no external resources): the summary, the
+//! requirement coverage matrix (requirement → cases → verdict) and every case with its
+//! evidence; failing cases are listed first and open.
+
+use super::{escape, CaseReport, Coverage, Report, Status};
+use std::fmt::Write as _;
+
+const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;margin:2em;color:#222}\
+h1{font-size:1.5em}h2{font-size:1.2em;margin-top:2em}\
+table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:.2em .5em;vertical-align:top;text-align:left}\
+.pass{color:#176f2c}.fail{color:#b00020;font-weight:bold}.expected-failure{color:#a15c00}.fixed{color:#0057b3}\
+.skipped,.not-run,.untested{color:#777}code,pre{font:12px ui-monospace,monospace}pre{white-space:pre-wrap;margin:0}\
+details{margin:.3em 0;border-left:3px solid #ddd;padding-left:.6em}summary{cursor:pointer}\
+.bad{background:#fde8ea}.muted{color:#777}";
+
+/// The report as one HTML page.
+pub fn html(r: &Report) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>drivespec conform: {}</title><style>{STYLE}</style></head><body>\n",
+        escape(&r.run.dut)
+    );
+    let s = &r.summary;
+    let verdict = if s.exit_code == 0 { "pass" } else { "fail" };
+    let families: Vec<String> = r.run.families.iter().map(|f| f.to_string()).collect();
+    let _ = writeln!(
+        h,
+        "<h1>drivespec conform {}: <span class=\"{verdict}\">{}</span></h1>",
+        escape(&families.join(", ")),
+        verdict.to_uppercase()
+    );
+    let _ = writeln!(
+        h,
+        "<table><tr><th>device under test</th><td><code>{}</code> ({})</td></tr><tr><th>seed</th><td>{}</td></tr><tr><th>address</th><td>{}</td></tr><tr><th>selection</th><td>level {}{}{}</td></tr><tr><th>expectations</th><td>{}</td></tr><tr><th>tool</th><td>{} {}</td></tr></table>",
+        escape(&r.run.dut),
+        escape(&r.run.transport),
+        r.run.seed,
+        r.run.address,
+        escape(&r.run.level),
+        if r.run.case.is_empty() { String::new() } else { format!("; --case {}", escape(&r.run.case.join(" "))) },
+        if r.run.skip.is_empty() { String::new() } else { format!("; --skip {}", escape(&r.run.skip.join(" "))) },
+        escape(r.run.expectations.as_deref().unwrap_or("none")),
+        escape(&r.tool.name),
+        escape(&r.tool.version),
+    );
+    let _ = writeln!(
+        h,
+        "<table><tr><th>cases</th><th class=\"pass\">pass</th><th class=\"fail\">fail</th><th class=\"expected-failure\">expected failures</th><th class=\"fixed\">fixed</th><th class=\"skipped\">skipped</th><th class=\"not-run\">not run</th></tr><tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr></table>",
+        s.total, s.passed, s.failed, s.expected_failures, s.fixed, s.skipped, s.not_run
+    );
+    for u in &r.run.unavailable {
+        let _ = writeln!(
+            h,
+            "<p class=\"muted\">{}: {}</p>",
+            u.family,
+            escape(&u.reason)
+        );
+    }
+    for k in &r.stale_expectations {
+        let _ = writeln!(
+            h,
+            "<p class=\"muted\">expectations entry <code>{}</code> matches no selected case ({})</p>",
+            escape(&k.case),
+            escape(&k.reason)
+        );
+    }
+
+    h.push_str("<h2>Requirement coverage</h2>\n<table><tr><th>requirement</th><th>level</th><th>verdict</th><th>cases</th><th>text</th></tr>\n");
+    for row in &r.coverage {
+        let v = match row.verdict {
+            Coverage::Pass => "pass",
+            Coverage::Fail => "fail",
+            Coverage::NotRun => "not-run",
+            Coverage::Untested => "untested",
+        };
+        let cases: Vec<String> = row
+            .cases
+            .iter()
+            .map(|c| {
+                format!(
+                    "<a href=\"#{}\" class=\"{}\">{}</a>",
+                    anchor(&c.id),
+                    c.status.as_str(),
+                    escape(&c.id)
+                )
+            })
+            .collect();
+        let cases = if cases.len() > 12 {
+            let shown = cases.iter().take(12).cloned().collect::<Vec<_>>().join(" ");
+            format!(
+                "<details><summary>{} cases</summary>{}</details>",
+                cases.len(),
+                [
+                    shown,
+                    cases.iter().skip(12).cloned().collect::<Vec<_>>().join(" ")
+                ]
+                .join(" ")
+            )
+        } else {
+            cases.join(" ")
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td><code>{}</code></td><td>{}</td><td class=\"{v}\">{v}</td><td>{cases}</td><td>{}</td></tr>",
+            escape(&row.requirement),
+            row.level.as_str(),
+            escape(&row.text)
+        );
+    }
+    h.push_str("</table>\n<h2>Cases</h2>\n");
+    let order = |c: &&CaseReport| match c.status {
+        Status::Fail => 0,
+        Status::ExpectedFailure => 1,
+        Status::Fixed => 2,
+        _ => 3,
+    };
+    let mut cases: Vec<&CaseReport> = r.cases.iter().collect();
+    cases.sort_by_key(order);
+    for c in cases {
+        case(&mut h, c);
+    }
+    h.push_str("</body></html>\n");
+    h
+}
+
+fn anchor(id: &str) -> String {
+    id.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect()
+}
+
+fn case(h: &mut String, c: &CaseReport) {
+    let open = if c.status == Status::Fail {
+        " open"
+    } else {
+        ""
+    };
+    let _ = writeln!(
+        h,
+        "<details id=\"{}\"{open}><summary><span class=\"{}\">{}</span> <code>{}</code> ({}) {}</summary>",
+        anchor(&c.id),
+        c.status.as_str(),
+        c.status.as_str(),
+        escape(&c.id),
+        c.level.as_str(),
+        escape(&c.description)
+    );
+    if let Some(f) = &c.failure {
+        let _ = writeln!(
+            h,
+            "<p class=\"fail\">{}</p><table><tr><th>expected</th><td><code>{}</code></td></tr><tr><th>got</th><td><code>{}</code></td></tr></table>",
+            escape(&f.message),
+            escape(&f.expected),
+            escape(&f.got)
+        );
+        for r in &f.requirements {
+            let _ = writeln!(
+                h,
+                "<p><code>{}</code> ({}): {}</p>",
+                escape(&r.id),
+                r.level.as_str(),
+                escape(&r.text)
+            );
+        }
+    }
+    if let Some(e) = &c.expectation {
+        let _ = writeln!(
+            h,
+            "<p class=\"expected-failure\">known failure: {}</p>",
+            escape(e)
+        );
+    }
+    if let Some(s) = &c.skip_reason {
+        let _ = writeln!(h, "<p class=\"skipped\">skipped: {}</p>", escape(s));
+    }
+    if let Some(r) = &c.replay {
+        let _ = writeln!(h, "<p>replay: <code>{}</code></p>", escape(r));
+    }
+    let _ = writeln!(
+        h,
+        "<p class=\"muted\">requirements: {}</p>",
+        escape(&c.requirements.join(", "))
+    );
+    if !c.evidence.is_empty() && c.status != Status::Pass {
+        h.push_str("<table><tr><th>#</th><th>role</th><th>step</th><th>sent</th><th>reference</th><th>device</th><th>note</th></tr>\n");
+        for e in &c.evidence {
+            let class = if e.ok == Some(false) {
+                " class=\"bad\""
+            } else {
+                ""
+            };
+            let ans = |a: &Option<crate::case::Answer>| match a {
+                Some(a) if a.is_silence() => "silence".to_owned(),
+                Some(a) => format!(
+                    "<code>{}</code><br><span class=\"muted\">{}{}</span>",
+                    escape(&a.hex),
+                    escape(&a.text),
+                    a.delay_us
+                        .map(|d| format!(", after {d} µs"))
+                        .unwrap_or_default()
+                ),
+                None => String::new(),
+            };
+            let _ = writeln!(
+                h,
+                "<tr{class}><td>{}</td><td>{:?}</td><td>{}</td><td><code>{}</code><br><span class=\"muted\">{}</span></td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                e.step,
+                e.role,
+                escape(&e.action),
+                escape(e.sent.as_deref().unwrap_or("")),
+                escape(e.sent_text.as_deref().unwrap_or("")),
+                ans(&e.expected),
+                ans(&e.got),
+                escape(e.note.as_deref().unwrap_or(""))
+            );
+        }
+        h.push_str("</table>\n");
+    }
+    h.push_str("</details>\n");
+}

@@ -1,0 +1,288 @@
+//! The run report: one data model (serialised as the JSON report, schema in `REPORTS.md`),
+//! rendered as JUnit XML and as a self-contained HTML page. Files are written atomically:
+//! to a temporary file in the same folder, flushed, then renamed over the target, so a reader
+//! never sees half a report.
+
+mod html;
+mod junit;
+
+pub use html::html;
+pub use junit::junit;
+
+use crate::case::{Failure, Record};
+use drivespec_spec::{FamilyId, Level};
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+
+/// Name and version of the JSON schema (`REPORTS.md`).
+pub const SCHEMA: &str = "drivespec-conform/1";
+
+/// A case's final status, with expectations applied.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Status {
+    /// Passed.
+    Pass,
+    /// Failed and not expected to: fails the run.
+    Fail,
+    /// Failed as the expectations file says.
+    ExpectedFailure,
+    /// Listed as a known failure but passed: remove it from the file.
+    Fixed,
+    /// Not run, with a reason (a capability the transport lacks).
+    Skipped,
+    /// Not run because `--fail-fast` stopped the run.
+    NotRun,
+}
+
+impl Status {
+    /// The name used in reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Pass => "pass",
+            Status::Fail => "fail",
+            Status::ExpectedFailure => "expected-failure",
+            Status::Fixed => "fixed",
+            Status::Skipped => "skipped",
+            Status::NotRun => "not-run",
+        }
+    }
+}
+
+/// The whole report.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// `drivespec-conform/1`.
+    pub schema: &'static str,
+    /// The tool that wrote it.
+    pub tool: Tool,
+    /// How the run was set up.
+    pub run: RunInfo,
+    /// Counts and the exit status.
+    pub summary: Counts,
+    /// Every selected case, in run order.
+    pub cases: Vec<CaseReport>,
+    /// Requirement → cases → verdict.
+    pub coverage: Vec<CoverageRow>,
+    /// Expectations entries that matched no selected case.
+    pub stale_expectations: Vec<crate::select::KnownFailure>,
+}
+
+/// Tool name and version.
+#[derive(Debug, Clone, Serialize)]
+pub struct Tool {
+    /// `drivespec`.
+    pub name: String,
+    /// Crate version.
+    pub version: String,
+}
+
+/// How the run was set up.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunInfo {
+    /// Families run.
+    pub families: Vec<FamilyId>,
+    /// The device under test as given (`sim`, `tcp:…`).
+    pub dut: String,
+    /// What the transport says it is connected to.
+    pub transport: String,
+    /// Seed of the case values.
+    pub seed: u64,
+    /// Device address.
+    pub address: u8,
+    /// Device model, when given.
+    pub model: Option<String>,
+    /// `--case` patterns.
+    pub case: Vec<String>,
+    /// `--skip` patterns.
+    pub skip: Vec<String>,
+    /// `must` or `should`.
+    pub level: String,
+    /// The expectations file, when given.
+    pub expectations: Option<String>,
+    /// Families asked for that have no suite yet, with the reason.
+    pub unavailable: Vec<Unavailable>,
+}
+
+/// A family without a suite.
+#[derive(Debug, Clone, Serialize)]
+pub struct Unavailable {
+    /// The family.
+    pub family: FamilyId,
+    /// Why.
+    pub reason: String,
+}
+
+/// Counts of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Counts {
+    /// Cases selected.
+    pub total: usize,
+    /// Passed.
+    pub passed: usize,
+    /// Failed unexpectedly.
+    pub failed: usize,
+    /// Failed as expected.
+    pub expected_failures: usize,
+    /// Expected to fail but passed.
+    pub fixed: usize,
+    /// Skipped with a reason.
+    pub skipped: usize,
+    /// Not run (fail-fast).
+    pub not_run: usize,
+    /// 0 pass, 1 failures (2 is never written: the run did not happen).
+    pub exit_code: u8,
+}
+
+/// One case in the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseReport {
+    /// Stable ID.
+    pub id: String,
+    /// Family.
+    pub family: FamilyId,
+    /// must or should.
+    pub level: Level,
+    /// One line.
+    pub description: String,
+    /// Requirement IDs covered.
+    pub requirements: Vec<String>,
+    /// Final status.
+    pub status: Status,
+    /// Why it failed (fail and expected-failure).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<Failure>,
+    /// Why it was skipped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skip_reason: Option<String>,
+    /// The expectations entry's reason (expected-failure and fixed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub expectation: Option<String>,
+    /// One record per step run.
+    pub evidence: Vec<Record>,
+    /// The command that runs this case alone (failures).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replay: Option<String>,
+    /// Wall time (ms).
+    pub wall_ms: f64,
+    /// Time on the transport's clock (µs; virtual for `sim`).
+    pub elapsed_us: u64,
+}
+
+/// Verdict of a requirement over its cases.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Coverage {
+    /// Every case run passed.
+    Pass,
+    /// A case failed (expected or not).
+    Fail,
+    /// Cases exist but none ran (skipped, not selected, not run).
+    NotRun,
+    /// No case covers it.
+    Untested,
+}
+
+/// One row of the coverage matrix.
+#[derive(Debug, Clone, Serialize)]
+pub struct CoverageRow {
+    /// Requirement ID.
+    pub requirement: String,
+    /// must, should or informative.
+    pub level: Level,
+    /// Its text.
+    pub text: String,
+    /// Verdict over the cases.
+    pub verdict: Coverage,
+    /// The cases that cover it, with their status.
+    pub cases: Vec<CaseRef>,
+}
+
+/// A case in the coverage matrix.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseRef {
+    /// Case ID.
+    pub id: String,
+    /// Its status.
+    pub status: Status,
+}
+
+impl Report {
+    /// The JSON report.
+    pub fn json(&self) -> String {
+        serde_json::to_string_pretty(self)
+            .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+    }
+}
+
+/// Writes `text` to `path` atomically (temporary file in the same folder, then rename).
+pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir)?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "report".to_owned());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(text.as_bytes())?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Escapes text for XML and HTML.
+pub(crate) fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            // Characters XML 1.0 does not allow.
+            c if (c as u32) < 0x20 && !matches!(c, '\n' | '\r' | '\t') => out.push('\u{FFFD}'),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_replaces_and_leaves_no_temp() {
+        let dir = std::env::temp_dir().join(format!("conform-report-{}", std::process::id()));
+        let path = dir.join("r.json");
+        write_atomic(&path, "one").unwrap();
+        write_atomic(&path, "two").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "two");
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 1, "{names:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn escaping() {
+        assert_eq!(
+            escape("a<b>&\"'\u{1}"),
+            "a&lt;b&gt;&amp;&quot;&apos;\u{FFFD}"
+        );
+    }
+}

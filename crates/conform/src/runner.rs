@@ -1,0 +1,546 @@
+//! The runner: selects cases, runs them on the device under test, applies the expectations
+//! file, shows progress and writes the reports. The CLI passes parsed [`Options`] to [`run`]
+//! and exits with [`Summary::exit_code`].
+//!
+//! Runner contract (after toml-test and JSONTestSuite): exit 0 when every selected case
+//! passed or failed as the expectations file says; 1 when a case failed unexpectedly; 2 for
+//! bad usage or a device under test that cannot be reached at all ([`ConformError`]). A
+//! device that misbehaves during the run fails cases, with evidence; the run goes on and the
+//! reports are always written.
+
+use crate::case::{CaseInfo, CaseRun, Outcome};
+use crate::dut::{shell_quote, Dut};
+use crate::report::{
+    self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, Report, RunInfo, Status, Tool,
+    Unavailable,
+};
+use crate::select::{Expectations, LevelFilter, SelectError, Selection};
+use crate::suite::{self, Session, Settings, SetupError, Suite};
+use drivespec_spec::{FamilyId, Level, Spec};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// How progress is shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Progress {
+    /// A progress bar on a terminal, plain lines otherwise and when `CI=true`.
+    #[default]
+    Auto,
+    /// A bar redrawn in place.
+    Bar,
+    /// One line per case.
+    Plain,
+    /// Nothing but the summary.
+    Quiet,
+}
+
+impl Progress {
+    /// `Auto` resolved for stderr and the environment.
+    pub fn resolve(self) -> Progress {
+        use std::io::IsTerminal;
+        match self {
+            Progress::Auto => {
+                let ci =
+                    std::env::var("CI").is_ok_and(|v| v.eq_ignore_ascii_case("true") || v == "1");
+                if !ci && std::io::stderr().is_terminal() {
+                    Progress::Bar
+                } else {
+                    Progress::Plain
+                }
+            }
+            p => p,
+        }
+    }
+}
+
+/// Everything `drivespec conform` takes.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Families to run; empty: every family that has a suite (`all`).
+    pub families: Vec<FamilyId>,
+    /// The device under test.
+    pub dut: Dut,
+    /// Address, seed, model, slack.
+    pub settings: Settings,
+    /// `--case` patterns.
+    pub case: Vec<String>,
+    /// `--skip` patterns.
+    pub skip: Vec<String>,
+    /// `--level`.
+    pub level: LevelFilter,
+    /// `--expect FILE`.
+    pub expect: Option<PathBuf>,
+    /// `--list`: list the selected cases, run nothing.
+    pub list: bool,
+    /// `--fail-fast`: stop at the first unexpected failure.
+    pub fail_fast: bool,
+    /// Folder of the reports (default `reports`).
+    pub report_dir: PathBuf,
+    /// JUnit file (default `<report_dir>/conform.junit.xml`).
+    pub junit: Option<PathBuf>,
+    /// JSON file (default `<report_dir>/conform.json`).
+    pub json: Option<PathBuf>,
+    /// HTML file (default `<report_dir>/conform.html`).
+    pub html: Option<PathBuf>,
+    /// Write no report files.
+    pub no_reports: bool,
+    /// How progress is shown.
+    pub progress: Progress,
+    /// The command that starts a run, for replay lines (`drivespec conform`).
+    pub command: String,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            families: vec![FamilyId::Hpd],
+            dut: Dut::default(),
+            settings: Settings::default(),
+            case: Vec::new(),
+            skip: Vec::new(),
+            level: LevelFilter::default(),
+            expect: None,
+            list: false,
+            fail_fast: false,
+            report_dir: PathBuf::from("reports"),
+            junit: None,
+            json: None,
+            html: None,
+            no_reports: false,
+            progress: Progress::Auto,
+            command: "drivespec conform".to_owned(),
+        }
+    }
+}
+
+/// Why a run could not happen (exit 2).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConformError {
+    /// Bad usage: options, patterns, the expectations file.
+    #[error(transparent)]
+    Select(#[from] SelectError),
+    /// A suite or the transport could not be set up.
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    /// No family asked for has a suite.
+    #[error("no conformance suite for {0}")]
+    Nothing(String),
+    /// A report could not be written.
+    #[error("cannot write {file}: {why}")]
+    Write {
+        /// The file.
+        file: String,
+        /// Why.
+        why: String,
+    },
+}
+
+/// What a run gives back.
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// The report (also written to the files).
+    pub report: Report,
+    /// Files written.
+    pub written: Vec<PathBuf>,
+    /// With `--list`: the selected cases.
+    pub listed: Vec<CaseInfo>,
+}
+
+impl Summary {
+    /// 0 all pass or only expected failures, 1 failures.
+    pub fn exit_code(&self) -> u8 {
+        self.report.summary.exit_code
+    }
+}
+
+/// Runs the conformance suites of `opts` and writes the reports.
+pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summary, ConformError> {
+    let selection = Selection::new(&opts.case, &opts.skip, opts.level)?;
+    let expectations = match &opts.expect {
+        Some(p) => Expectations::load(p)?,
+        None => Expectations::default(),
+    };
+    let mut settings = opts.settings.clone();
+    match &opts.dut {
+        Dut::Sim { model: Some(m) } if settings.model.is_none() => settings.model = Some(m.clone()),
+        Dut::Serial { baud: Some(b), .. } if settings.bit_rate.is_none() => {
+            settings.bit_rate = Some(*b)
+        }
+        _ => {}
+    }
+    let wanted: Vec<FamilyId> = if opts.families.is_empty() {
+        FamilyId::ALL.to_vec()
+    } else {
+        opts.families.clone()
+    };
+    let mut suites: Vec<Box<dyn Suite + '_>> = Vec::new();
+    let mut unavailable = Vec::new();
+    for f in wanted {
+        match suite::suite(spec, f, &settings) {
+            Ok(s) => suites.push(s),
+            Err(SetupError::NoSuite(f)) => unavailable.push(Unavailable {
+                family: f,
+                reason: format!("no conformance suite for {f} yet: its reference model and cyclic-exchange adapter protocol are not written"),
+            }),
+            Err(e) => return Err(e.into()),
+        }
+    }
+    if suites.is_empty() {
+        let names: Vec<String> = unavailable.iter().map(|u| u.family.to_string()).collect();
+        return Err(ConformError::Nothing(names.join(", ")));
+    }
+    let mut plan: Vec<(usize, usize)> = Vec::new();
+    for (si, s) in suites.iter().enumerate() {
+        for (ci, c) in s.cases().iter().enumerate() {
+            if selection.admits(&c.id, c.level) {
+                plan.push((si, ci));
+            }
+        }
+    }
+    if opts.list {
+        let listed = plan
+            .iter()
+            .filter_map(|(si, ci)| suites.get(*si).and_then(|s| s.cases().get(*ci)).cloned())
+            .collect();
+        let report = build_report(
+            opts,
+            &settings,
+            &suites,
+            Vec::new(),
+            "",
+            unavailable,
+            &expectations,
+            spec,
+        );
+        return Ok(Summary {
+            report,
+            written: Vec::new(),
+            listed,
+        });
+    }
+    let mut sessions: Vec<Box<dyn Session + '_>> = Vec::new();
+    for s in &suites {
+        sessions.push(s.open(&opts.dut)?);
+    }
+    let transport = sessions.first().map(|s| s.describe()).unwrap_or_default();
+    let mode = opts.progress.resolve();
+    let mut results: Vec<CaseReport> = Vec::new();
+    let mut stop = false;
+    let total = plan.len();
+    for (n, (si, ci)) in plan.iter().enumerate() {
+        let (Some(suite), Some(session)) = (suites.get(*si), sessions.get_mut(*si)) else {
+            continue;
+        };
+        let Some(info) = suite.cases().get(*ci) else {
+            continue;
+        };
+        let known = expectations.known(&info.id);
+        if stop {
+            results.push(case_report(
+                info,
+                None,
+                Status::NotRun,
+                known.map(|k| k.reason.clone()),
+                None,
+                0.0,
+            ));
+            continue;
+        }
+        let started = Instant::now();
+        let run = session.run(*ci);
+        let wall_ms = started.elapsed().as_secs_f64() * 1000.0;
+        let status = match (&run.outcome, known) {
+            (Outcome::Pass, None) => Status::Pass,
+            (Outcome::Pass, Some(_)) => Status::Fixed,
+            (Outcome::Fail(_), None) => Status::Fail,
+            (Outcome::Fail(_), Some(_)) => Status::ExpectedFailure,
+            (Outcome::Skip { .. }, _) => Status::Skipped,
+        };
+        let replay = run
+            .outcome
+            .failed()
+            .then(|| replay_line(opts, &settings, &info.id));
+        show(
+            progress,
+            mode,
+            n + 1,
+            total,
+            &info.id,
+            status,
+            replay.as_deref(),
+        );
+        if status == Status::Fail && opts.fail_fast {
+            stop = true;
+        }
+        results.push(case_report(
+            info,
+            Some(run),
+            status,
+            known.map(|k| k.reason.clone()),
+            replay,
+            wall_ms,
+        ));
+    }
+    if mode == Progress::Bar {
+        let _ = writeln!(progress);
+    }
+    let report = build_report(
+        opts,
+        &settings,
+        &suites,
+        results,
+        &transport,
+        unavailable,
+        &expectations,
+        spec,
+    );
+    let written = if opts.no_reports {
+        Vec::new()
+    } else {
+        write_reports(opts, &report)?
+    };
+    Ok(Summary {
+        report,
+        written,
+        listed: Vec::new(),
+    })
+}
+
+fn show(
+    out: &mut dyn Write,
+    mode: Progress,
+    n: usize,
+    total: usize,
+    id: &str,
+    status: Status,
+    replay: Option<&str>,
+) {
+    match mode {
+        Progress::Quiet | Progress::Auto => {}
+        Progress::Plain => {
+            let _ = writeln!(out, "{:<16} {id} ({n}/{total})", status.as_str());
+            if let (Status::Fail, Some(r)) = (status, replay) {
+                let _ = writeln!(out, "  replay: {r}");
+            }
+        }
+        Progress::Bar => {
+            if status == Status::Fail {
+                let _ = write!(out, "\r\x1b[2K");
+                let _ = writeln!(out, "fail {id}");
+                if let Some(r) = replay {
+                    let _ = writeln!(out, "  replay: {r}");
+                }
+            }
+            let width = 30;
+            let done = n * width / total.max(1);
+            let bar: String = "#".repeat(done) + &"-".repeat(width - done);
+            let short: String = id.chars().take(50).collect();
+            let _ = write!(out, "\r\x1b[2K[{bar}] {n}/{total} {short}");
+            let _ = out.flush();
+        }
+    }
+}
+
+fn case_report(
+    info: &CaseInfo,
+    run: Option<CaseRun>,
+    status: Status,
+    expectation: Option<String>,
+    replay: Option<String>,
+    wall_ms: f64,
+) -> CaseReport {
+    let (failure, skip_reason, evidence, elapsed_us) = match run {
+        Some(r) => {
+            let (failure, skip) = match r.outcome {
+                Outcome::Pass => (None, None),
+                Outcome::Fail(f) => (Some(f), None),
+                Outcome::Skip { reason } => (None, Some(reason)),
+            };
+            (failure, skip, r.evidence, r.elapsed_us)
+        }
+        None => (None, None, Vec::new(), 0),
+    };
+    let expectation = match status {
+        Status::ExpectedFailure | Status::Fixed | Status::NotRun => expectation,
+        _ => None,
+    };
+    CaseReport {
+        id: info.id.clone(),
+        family: info.family,
+        level: info.level,
+        description: info.description.clone(),
+        requirements: info.requirements.clone(),
+        status,
+        failure,
+        skip_reason,
+        expectation,
+        evidence,
+        replay,
+        wall_ms,
+        elapsed_us,
+    }
+}
+
+/// The command line that runs one case alone against the same device.
+fn replay_line(opts: &Options, settings: &Settings, id: &str) -> String {
+    let family = id.split('/').next().unwrap_or("all");
+    let mut words = vec![opts.command.clone(), family.to_owned()];
+    words.push(format!("--dut {}", shell_quote(&opts.dut.to_string())));
+    words.push(format!("--case {}", shell_quote(id)));
+    if settings.seed != 0 {
+        words.push(format!("--seed {}", settings.seed));
+    }
+    if settings.address != 0 {
+        words.push(format!("--address {}", settings.address));
+    }
+    if let (Some(m), false) = (
+        &settings.model,
+        matches!(opts.dut, Dut::Sim { model: Some(_) }),
+    ) {
+        words.push(format!("--model {}", shell_quote(m)));
+    }
+    words.join(" ")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn build_report(
+    opts: &Options,
+    settings: &Settings,
+    suites: &[Box<dyn Suite + '_>],
+    cases: Vec<CaseReport>,
+    transport: &str,
+    unavailable: Vec<Unavailable>,
+    expectations: &Expectations,
+    spec: &Spec,
+) -> Report {
+    let mut counts = Counts {
+        total: cases.len(),
+        ..Counts::default()
+    };
+    for c in &cases {
+        match c.status {
+            Status::Pass => counts.passed += 1,
+            Status::Fail => counts.failed += 1,
+            Status::ExpectedFailure => counts.expected_failures += 1,
+            Status::Fixed => counts.fixed += 1,
+            Status::Skipped => counts.skipped += 1,
+            Status::NotRun => counts.not_run += 1,
+        }
+    }
+    counts.exit_code = u8::from(counts.failed > 0);
+    let families: Vec<FamilyId> = suites.iter().map(|s| s.family()).collect();
+    let mut coverage = Vec::new();
+    for s in suites {
+        let family = spec.family(s.family());
+        for req in &family.requirements {
+            let refs: Vec<CaseRef> = s
+                .cases()
+                .iter()
+                .filter(|c| c.requirements.contains(&req.id))
+                .map(|c| CaseRef {
+                    id: c.id.clone(),
+                    status: cases
+                        .iter()
+                        .find(|r| r.id == c.id)
+                        .map_or(Status::NotRun, |r| r.status),
+                })
+                .collect();
+            if req.level == Level::Informative && refs.is_empty() {
+                continue;
+            }
+            let ran: Vec<Status> = refs
+                .iter()
+                .map(|r| r.status)
+                .filter(|s| !matches!(s, Status::Skipped | Status::NotRun))
+                .collect();
+            let verdict = if refs.is_empty() {
+                Coverage::Untested
+            } else if ran.is_empty() {
+                Coverage::NotRun
+            } else if ran
+                .iter()
+                .any(|s| matches!(s, Status::Fail | Status::ExpectedFailure))
+            {
+                Coverage::Fail
+            } else {
+                Coverage::Pass
+            };
+            coverage.push(CoverageRow {
+                requirement: req.id.clone(),
+                level: req.level,
+                text: req.text.clone(),
+                verdict,
+                cases: refs,
+            });
+        }
+    }
+    let ids: Vec<&str> = suites
+        .iter()
+        .flat_map(|s| s.cases().iter())
+        .filter(|c| {
+            Selection::new(&opts.case, &opts.skip, opts.level)
+                .is_ok_and(|sel| sel.admits(&c.id, c.level))
+        })
+        .map(|c| c.id.as_str())
+        .collect();
+    let stale = expectations.stale(&ids).into_iter().cloned().collect();
+    Report {
+        schema: report::SCHEMA,
+        tool: Tool {
+            name: "drivespec".to_owned(),
+            version: env!("CARGO_PKG_VERSION").to_owned(),
+        },
+        run: RunInfo {
+            families,
+            dut: opts.dut.to_string(),
+            transport: transport.to_owned(),
+            seed: settings.seed,
+            address: settings.address,
+            model: settings.model.clone(),
+            case: opts.case.clone(),
+            skip: opts.skip.clone(),
+            level: opts.level.as_str().to_owned(),
+            expectations: expectations.file.clone(),
+            unavailable,
+        },
+        summary: counts,
+        cases,
+        coverage,
+        stale_expectations: stale,
+    }
+}
+
+fn write_reports(opts: &Options, report: &Report) -> Result<Vec<PathBuf>, ConformError> {
+    let dir = &opts.report_dir;
+    let files = [
+        (
+            opts.junit
+                .clone()
+                .unwrap_or_else(|| dir.join("conform.junit.xml")),
+            report::junit(report),
+        ),
+        (
+            opts.json
+                .clone()
+                .unwrap_or_else(|| dir.join("conform.json")),
+            report.json(),
+        ),
+        (
+            opts.html
+                .clone()
+                .unwrap_or_else(|| dir.join("conform.html")),
+            report::html(report),
+        ),
+    ];
+    let mut written = Vec::new();
+    for (path, text) in files {
+        report::write_atomic(&path, &text).map_err(|e| ConformError::Write {
+            file: path.display().to_string(),
+            why: e.to_string(),
+        })?;
+        written.push(path);
+    }
+    Ok(written)
+}

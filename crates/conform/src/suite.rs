@@ -1,0 +1,78 @@
+//! One family's conformance suite: its cases and how to run them on a device under test.
+//!
+//! A family plugs in by implementing [`Suite`] (the case list, opening a session on a
+//! `--dut`) and [`Session`] (running one case against the device and the family's reference
+//! model). The runner, selection, expectations and reports are shared. HPD is implemented in
+//! [`crate::hpd`]; PSD4xx and PSx3xx join with their own reference models and a cyclic
+//! exchange over the same [`crate::link::Link`] transports.
+
+use crate::case::{CaseInfo, CaseRun};
+use crate::dut::Dut;
+use crate::link::{LinkError, Micros};
+use drivespec_spec::{FamilyId, Spec};
+
+/// How cases are generated and sessions opened.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Settings {
+    /// Serial/bus address of the device under test (HPD Pr27).
+    pub address: u8,
+    /// Seed of the values cases pick.
+    pub seed: u64,
+    /// Device model (`--model`, or the `sim:MODEL` suffix).
+    pub model: Option<String>,
+    /// Extra time allowed for an answer on real transports (µs); None: per transport.
+    pub slack_us: Option<Micros>,
+    /// Bit rate of the line (serial `?baud=`); None: the delivery value.
+    pub bit_rate: Option<u32>,
+}
+
+/// Why a suite or a session cannot be set up.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SetupError {
+    /// The transport cannot be opened.
+    #[error(transparent)]
+    Link(#[from] LinkError),
+    /// The options do not fit the family (unknown model, address out of range, …).
+    #[error("{0}")]
+    Usage(String),
+    /// The spec lacks what the suite needs.
+    #[error("spec: {0}")]
+    Spec(String),
+    /// The family has no suite yet.
+    #[error("no conformance suite for {0} yet")]
+    NoSuite(FamilyId),
+}
+
+/// The cases of one family.
+pub trait Suite {
+    /// The family.
+    fn family(&self) -> FamilyId;
+
+    /// Every case, in run order.
+    fn cases(&self) -> &[CaseInfo];
+
+    /// Opens a session on the device under test.
+    fn open(&self, dut: &Dut) -> Result<Box<dyn Session + '_>, SetupError>;
+}
+
+/// A connection to one device under test with its reference model.
+pub trait Session {
+    /// The device under test, one line.
+    fn describe(&self) -> String;
+
+    /// Runs case `index` of the suite; never panics, always returns (bounded in time).
+    fn run(&mut self, index: usize) -> CaseRun;
+}
+
+/// The suite of `family`, generated from the spec.
+pub fn suite<'s>(
+    spec: &'s Spec,
+    family: FamilyId,
+    settings: &Settings,
+) -> Result<Box<dyn Suite + 's>, SetupError> {
+    match family {
+        FamilyId::Hpd => Ok(Box::new(crate::hpd::HpdSuite::new(spec, settings)?)),
+        other => Err(SetupError::NoSuite(other)),
+    }
+}

@@ -1,0 +1,98 @@
+//! Snapshots of the JSON and JUnit reports of a small run against `sim`: a passing case, a
+//! corrupt-frame case, a case the expectations file lists although it passes (`fixed`), and a
+//! stale expectations entry. Wall-clock times and the temporary path are normalised.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use drivespec_conform::report::junit;
+use drivespec_conform::{run, Options, Progress};
+use drivespec_spec::Spec;
+
+fn small_run(tag: &str) -> drivespec_conform::Summary {
+    let dir = std::env::temp_dir().join(format!("conform-snap-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let expect = dir.join("expect.toml");
+    std::fs::write(
+        &expect,
+        "[[failure]]\ncase = \"hpd/frame/read-lun-1\"\nreason = \"thought to answer 2 bytes\"\n\n\
+         [[failure]]\ncase = \"hpd/param/Pr999/*\"\nreason = \"no such parameter\"\n",
+    )
+    .unwrap();
+    let spec = Spec::builtin().unwrap();
+    let opts = Options {
+        case: vec![
+            "hpd/frame/read-parameter".into(),
+            "hpd/frame/checksum-bad/read-parameter".into(),
+            "hpd/frame/read-lun-1".into(),
+        ],
+        expect: Some(expect),
+        progress: Progress::Quiet,
+        no_reports: true,
+        ..Options::default()
+    };
+    let s = run(&spec, &opts, &mut std::io::sink()).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    s
+}
+
+#[test]
+fn json_report_of_a_small_run() {
+    let s = small_run("json");
+    let mut v: serde_json::Value = serde_json::from_str(&s.report.json()).unwrap();
+    for c in v["cases"].as_array_mut().unwrap() {
+        c["wall_ms"] = 0.into();
+    }
+    v["run"]["expectations"] = "EXPECT.toml".into();
+    v["tool"]["version"] = "VERSION".into();
+    // The coverage matrix lists every requirement: keep the rows these cases touch.
+    let rows: Vec<serde_json::Value> = v["coverage"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| {
+            !r["cases"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|c| c["status"] == "not-run")
+        })
+        .map(|r| {
+            let mut r = r.clone();
+            let run: Vec<serde_json::Value> = r["cases"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|c| c["status"] != "not-run")
+                .cloned()
+                .collect();
+            r["cases"] = run.into();
+            r
+        })
+        .collect();
+    v["coverage"] = rows.into();
+    insta::assert_json_snapshot!(v);
+    assert_eq!(s.exit_code(), 0);
+}
+
+#[test]
+fn junit_report_of_a_small_run() {
+    let s = small_run("junit");
+    let x = junit(&s.report);
+    let mut out = String::new();
+    for line in x.lines() {
+        // time="…" is wall-clock time.
+        let mut l = line.to_owned();
+        while let Some(i) = l.find("time=\"") {
+            let rest = &l[i + 6..];
+            let end = rest.find('"').unwrap();
+            l = format!("{}TIME={}", &l[..i], &rest[end + 1..]);
+        }
+        out.push_str(&l);
+        out.push('\n');
+    }
+    insta::assert_snapshot!(out);
+}
