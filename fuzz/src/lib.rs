@@ -11,6 +11,7 @@
     clippy::indexing_slicing
 )]
 
+pub mod capture;
 pub mod hpd;
 pub mod pd;
 
@@ -30,4 +31,9 @@ pub const TARGETS: &[Target] = &[
     ("psx3xx_image", pd::psx3xx_image),
     ("psx3xx_isdu", pd::psx3xx_isdu),
     ("psx3xx_direct", pd::psx3xx_direct),
+    ("capture_pcap", capture::pcap),
+    ("capture_frame", capture::frame),
+    ("capture_pnio", capture::pnio),
+    ("capture_serial", capture::serial),
+    ("capture_iolink", capture::iolink),
 ];

@@ -1,0 +1,4 @@
+//! cargo-fuzz target `capture_frame`: see `drivespec_fuzz::capture::frame`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::capture::frame(data));

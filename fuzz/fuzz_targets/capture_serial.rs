@@ -1,0 +1,4 @@
+//! cargo-fuzz target `capture_serial`: see `drivespec_fuzz::capture::serial`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::capture::serial(data));
