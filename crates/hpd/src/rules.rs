@@ -91,6 +91,8 @@ pub struct FrameRules {
     codes: [u8; 7],
     /// Message kind of each CMD code (CMD has at most 8 values: 3 bits).
     kinds: [Option<MessageKind>; 8],
+    /// Mask of ADDR in CMD+ADDR.
+    addr_mask: u8,
 }
 
 impl FrameRules {
@@ -173,6 +175,7 @@ impl FrameRules {
             bit_change_lun,
             codes,
             kinds,
+            addr_mask: u8::try_from((1u32 << addr_bits.min(8)) - 1).unwrap_or(u8::MAX),
         }
     }
 
@@ -188,16 +191,14 @@ impl FrameRules {
 
     /// Splits CMD+ADDR into (CMD, ADDR).
     pub fn split(&self, cmd_addr: u8) -> (u8, u8) {
-        let mask = self.addr_mask();
-        (cmd_addr >> self.addr_bits, cmd_addr & mask)
+        (
+            cmd_addr.checked_shr(self.addr_bits).unwrap_or(0),
+            cmd_addr & self.addr_mask,
+        )
     }
 
     /// Joins CMD and ADDR into one byte.
     pub fn join(&self, cmd: u8, addr: u8) -> u8 {
-        (cmd << self.addr_bits) | (addr & self.addr_mask())
-    }
-
-    fn addr_mask(&self) -> u8 {
-        u8::try_from((1u32 << self.addr_bits.min(8)) - 1).unwrap_or(u8::MAX)
+        cmd.checked_shl(self.addr_bits).unwrap_or(0) | (addr & self.addr_mask)
     }
 }
