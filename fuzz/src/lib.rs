@@ -14,6 +14,7 @@
 pub mod capture;
 pub mod hpd;
 pub mod pd;
+pub mod psd4xx;
 
 /// A fuzz target: its name and the function it runs on each input.
 pub type Target = (&'static str, fn(&[u8]));
@@ -36,4 +37,5 @@ pub const TARGETS: &[Target] = &[
     ("capture_pnio", capture::pnio),
     ("capture_serial", capture::serial),
     ("capture_iolink", capture::iolink),
+    ("psd4xx_model", psd4xx::model),
 ];

@@ -10,6 +10,7 @@
 //! - [`PkwClient`]: the controller's side of the PKW handshake, sans-IO, one bus cycle at a time.
 //! - [`record`]: acyclic read and write records (3.2.2).
 //! - [`mod@explain`]: every field of an image by name, in words and as stable JSON.
+//! - [`model`]: the reference drive on virtual time (3.2–3.9, chapter 4).
 //!
 //! Everything numeric (offsets, lengths, codes, bit positions, record lengths) is read from the
 //! spec through [`Rules`]; the byte order and the PKW word and index layouts are [`Options`]
@@ -23,6 +24,7 @@
 mod client;
 mod error;
 pub mod explain;
+pub mod model;
 pub mod pkw;
 pub mod record;
 mod repr;
