@@ -15,6 +15,7 @@ pub mod capture;
 pub mod hpd;
 pub mod pd;
 pub mod psd4xx;
+pub mod psx3xx;
 
 /// A fuzz target: its name and the function it runs on each input.
 pub type Target = (&'static str, fn(&[u8]));
@@ -38,4 +39,5 @@ pub const TARGETS: &[Target] = &[
     ("capture_serial", capture::serial),
     ("capture_iolink", capture::iolink),
     ("psd4xx_model", psd4xx::model),
+    ("psx3xx_model", psx3xx::model),
 ];

@@ -1,8 +1,11 @@
 //! `drivespec`: the command-line front end. Parsing and printing only; the work is in the libraries.
 
 mod conform_cmd;
+mod fuzz_cmd;
 mod hpd_cmd;
 mod pd_cmd;
+mod sim_cmd;
+mod simrun_cmd;
 mod spec_cmd;
 
 use anyhow::{anyhow, bail, Result};
@@ -41,6 +44,12 @@ enum Command {
     },
     /// Run the conformance suite against a device under test (exit 1 on failures).
     Conform(conform_cmd::ConformArgs),
+    /// Fuzz a device under test with spec-generated sequences (exit 1 on findings).
+    Fuzz(fuzz_cmd::FuzzArgs),
+    /// Serve a reference model on TCP, a pseudo-terminal or stdin/stdout, with optional faults.
+    Sim(sim_cmd::SimArgs),
+    /// Play a script of timed commands on a reference model and print the trace.
+    SimRun(simrun_cmd::SimRunArgs),
     /// Assemble and disassemble PLC programs.
     Plc {
         #[command(subcommand)]
@@ -145,6 +154,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Spec(args) => spec_cmd::run(args, &ctx),
         Command::Conform(args) => conform_cmd::run(args, &ctx),
+        Command::Fuzz(args) => fuzz_cmd::run(args, &ctx),
+        Command::Sim(args) => sim_cmd::run(args, &ctx),
+        Command::SimRun(args) => simrun_cmd::run(args, &ctx),
         Command::Decode { device } => match device {
             DecodeDevice::Hpd(args) => hpd_cmd::decode(args, &ctx),
             DecodeDevice::Psd4xx(args) => pd_cmd::decode_psd4xx(args, &ctx),

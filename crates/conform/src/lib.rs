@@ -13,13 +13,17 @@
 #![forbid(unsafe_code)]
 
 pub mod case;
+pub mod cyclic;
 pub mod dut;
+pub mod fuzz;
 pub mod hpd;
 pub mod link;
+pub mod psd4xx;
 pub mod report;
 mod rng;
 pub mod runner;
 pub mod select;
+pub mod serve;
 pub mod suite;
 
 pub use runner::{run, ConformError, Options, Progress, Summary};

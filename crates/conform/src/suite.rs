@@ -73,6 +73,7 @@ pub fn suite<'s>(
 ) -> Result<Box<dyn Suite + 's>, SetupError> {
     match family {
         FamilyId::Hpd => Ok(Box::new(crate::hpd::HpdSuite::new(spec, settings)?)),
+        FamilyId::Psd4xx => Ok(Box::new(crate::psd4xx::Psd4xxSuite::new(spec, settings)?)),
         other => Err(SetupError::NoSuite(other)),
     }
 }

@@ -33,10 +33,10 @@ fn options(dut: Dut, cases: &[&str]) -> Options {
     }
 }
 
-/// Serves the reference drive on `listener` in wall-clock time, for `limit` at most.
-fn serve_reference(listener: TcpListener, limit: Duration) {
-    let spec = Spec::builtin().unwrap();
-    let mut drive = Drive::new(&spec, DriveConfig::commissioned(0)).unwrap();
+/// Serves `drive` on `listener` in wall-clock time, for `limit` at most. The drive is built
+/// before the thread starts: a server still loading the spec would leave the first requests
+/// unanswered (the kernel accepts the connection meanwhile).
+fn serve_reference(listener: TcpListener, mut drive: Drive, limit: Duration) {
     let start = Instant::now();
     listener.set_nonblocking(true).unwrap();
     let mut conn = None;
@@ -93,8 +93,10 @@ const TCP_CASES: &[&str] = &[
 fn tcp_against_the_reference_drive_passes() {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = listener.local_addr().unwrap();
-    let server = std::thread::spawn(move || serve_reference(listener, Duration::from_secs(60)));
     let spec = Spec::builtin().unwrap();
+    let drive = Drive::new(&spec, DriveConfig::commissioned(0)).unwrap();
+    let server =
+        std::thread::spawn(move || serve_reference(listener, drive, Duration::from_secs(60)));
     let opts = options(
         Dut::Tcp {
             addr: addr.to_string(),

@@ -21,6 +21,7 @@
 //!   external rotation, faults).
 //! - [`config`]: the family description ([`CoreConfig`]).
 //! - [`machine`]: the state machine ([`Positioner`]): runs, reference loop, faults, status.
+//! - [`script`]: the `sim-run` script grammar, expectations and traces every family shares.
 //!
 //! Guarantees: nothing here panics on any input, and nothing touches a port, a socket or the
 //! clock. Allocation is bounded by the spec tables (names) and by the width of a word
@@ -39,6 +40,7 @@ pub mod config;
 pub mod env;
 pub mod machine;
 pub mod profile;
+pub mod script;
 pub mod status;
 
 pub use bits::{decode_bits, BitsDecoded, NamedWord, SetBit};

@@ -21,6 +21,8 @@ use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 use std::sync::Arc;
 
+mod hooks;
+
 /// Virtual time in microseconds (chapter 4).
 pub type Micros = u64;
 

@@ -11,6 +11,7 @@
 //! - [`record`]: acyclic read and write records (3.2.2).
 //! - [`mod@explain`]: every field of an image by name, in words and as stable JSON.
 //! - [`model`]: the reference drive on virtual time (3.2–3.9, chapter 4).
+//! - [`script`]: `sim-run`: the family's script commands and the runner over [`model`].
 //!
 //! Everything numeric (offsets, lengths, codes, bit positions, record lengths) is read from the
 //! spec through [`Rules`]; the byte order and the PKW word and index layouts are [`Options`]
@@ -29,6 +30,7 @@ pub mod pkw;
 pub mod record;
 mod repr;
 mod rules;
+pub mod script;
 mod value;
 pub mod wire;
 

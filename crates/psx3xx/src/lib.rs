@@ -38,8 +38,10 @@ mod error;
 pub mod explain;
 pub mod guard;
 pub mod isdu;
+pub mod model;
 pub mod repr;
 pub mod rules;
+pub mod script;
 pub mod timestamp;
 pub mod wire;
 

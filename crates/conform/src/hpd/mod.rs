@@ -16,14 +16,12 @@
 //! | `vector` | the spec's `hpd-frame` vectors, at their drive address |
 
 mod behaviour;
-mod frame;
-mod gen;
-#[cfg(test)]
-mod mutants;
-mod names;
+pub(crate) mod frame;
+pub(crate) mod gen;
+pub(crate) mod names;
 mod params;
 mod session;
-mod step;
+pub(crate) mod step;
 
 pub use session::HpdSession;
 
@@ -146,6 +144,31 @@ impl<'s> HpdSuite<'s> {
     /// The reference drive as the cases expect the device at the start.
     pub fn reference(&self) -> &Drive {
         &self.baseline
+    }
+
+    /// Case `index` with its steps (the fuzzer's seeds).
+    pub(crate) fn case(&self, index: usize) -> Option<(&CaseInfo, &HpdCase)> {
+        Some((self.infos.get(index)?, self.cases.get(index)?))
+    }
+
+    /// The settings the suite was generated for.
+    pub(crate) fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// The spec the suite was generated from.
+    pub(crate) fn spec(&self) -> &'s Spec {
+        self.spec
+    }
+
+    /// The device model the suite was generated for, by id.
+    pub(crate) fn model_id(&self) -> Option<&str> {
+        self.model.as_deref()
+    }
+
+    /// Opens the transport `dut` names, on the suite's reference drive for `sim`.
+    pub(crate) fn link(&self, dut: &Dut) -> Result<Box<dyn Link>, SetupError> {
+        self.open_link(dut)
     }
 
     /// Opens a session on a link of the caller's (tests, embedding tools).

@@ -11,7 +11,7 @@
 
 use super::step::{Action, Compare, HpdCase, Step};
 use super::HpdSuite;
-use crate::case::{Answer, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::link::{concat, Chunk, Link, LinkError, Micros, Recovered};
 use crate::suite::Session;
 use drivespec_hpd::explain::explain;
@@ -29,8 +29,6 @@ pub struct HpdSession<'a, 's> {
     offset: Micros,
     /// Extra time allowed for answers (µs).
     slack: Micros,
-    /// Time to wait for trailing bytes after a complete answer on real transports (µs).
-    settle: Micros,
 }
 
 /// A judged step's (match, explanation), nothing to judge, or a transport error with the
@@ -48,14 +46,12 @@ struct Observed {
 
 impl<'a, 's> HpdSession<'a, 's> {
     pub(crate) fn new(suite: &'a HpdSuite<'s>, link: Box<dyn Link>, slack: Micros) -> Self {
-        let virtual_time = link.caps().virtual_time;
         HpdSession {
             suite,
             link,
             oracle: suite.baseline.clone(),
             offset: 0,
             slack,
-            settle: if virtual_time { 0 } else { slack.min(3_000) },
         }
     }
 
@@ -130,17 +126,13 @@ impl<'a, 's> HpdSession<'a, 's> {
             return Err((e, expected));
         }
         let mut enough = |b: &[u8]| want > 0 && b.len() >= want;
-        let mut got = match self.link.recv(t0 + window, &mut enough) {
+        // HPD answers are self-delimiting (LUN, or the 2-byte acknowledge): no wait after the
+        // last expected byte. Bytes read with the answer are judged with it; later ones are
+        // reported as late bytes before the next request.
+        let got = match self.link.recv(t0 + window, &mut enough) {
             Ok(g) => g,
             Err(e) => return Err((e, expected)),
         };
-        if want > 0 && self.settle > 0 && concat(&got).len() >= want {
-            let until = self.link.now() + self.settle;
-            match self.link.recv(until, &mut |_| false) {
-                Ok(more) => got.extend(more),
-                Err(e) => return Err((e, expected)),
-            }
-        }
         Ok(Observed {
             expected,
             got,
@@ -375,6 +367,70 @@ impl Session for HpdSession<'_, '_> {
                 elapsed_us: 0,
             };
         };
+        self.run_case(info, case, true)
+    }
+}
+
+impl HpdSession<'_, '_> {
+    /// Restarts or reconnects the device; a fresh device also gets a fresh reference.
+    pub(crate) fn recover(&mut self) -> Result<Recovered, LinkError> {
+        let r = self.link.recover()?;
+        if r == Recovered::Fresh {
+            self.reset_oracle();
+        }
+        Ok(r)
+    }
+
+    /// The reference powered up afresh now (after a restarted process first answered: its
+    /// power-up is closer to then than to the restart).
+    pub(crate) fn restart_reference(&mut self) {
+        self.reset_oracle();
+    }
+
+    /// Sends `bytes` (a read) to the device alone and waits for a whole answer (manual 4.1),
+    /// unjudged: a just-started process is then talking (its start-up grace is over). True
+    /// when bytes came.
+    pub(crate) fn wake(&mut self, bytes: &[u8]) -> bool {
+        let window = self.window();
+        let t0 = self.link.now();
+        if self.link.send(bytes).is_err() {
+            return false;
+        }
+        let rules = &self.suite.rules;
+        let mut whole = |b: &[u8]| {
+            let from = b.iter().position(|x| *x == rules.stx).unwrap_or(b.len());
+            matches!(
+                drivespec_hpd::decode(
+                    rules,
+                    b.get(from..).unwrap_or(&[]),
+                    drivespec_hpd::AckEnd::NextByte
+                ),
+                Ok(drivespec_hpd::Status::Complete(_))
+            )
+        };
+        self.link
+            .recv(t0 + window, &mut whole)
+            .is_ok_and(|c| !c.is_empty())
+    }
+
+    /// Resets the device and the reference to the start state, when the transport can.
+    pub(crate) fn reset(&mut self) -> Result<bool, LinkError> {
+        let done = self.link.reset()?;
+        if done {
+            self.reset_oracle();
+        }
+        Ok(done)
+    }
+
+    /// Runs `case` (described by `info`) as [`Session::run`] runs a suite case, judged step
+    /// by step against the reference; `from_start`: reset first on transports that can.
+    pub(crate) fn run_case(
+        &mut self,
+        info: &CaseInfo,
+        case: &HpdCase,
+        from_start: bool,
+    ) -> CaseRun {
+        let suite = self.suite;
         let caps = self.link.caps();
         if case.needs_power_cycle && !caps.power_cycle {
             return CaseRun {
@@ -386,7 +442,7 @@ impl Session for HpdSession<'_, '_> {
             };
         }
         let start = self.link.now();
-        if caps.reset {
+        if caps.reset && from_start {
             match self.link.reset() {
                 Ok(true) => self.reset_oracle(),
                 Ok(false) => {}
@@ -551,6 +607,21 @@ impl Session for HpdSession<'_, '_> {
                         Err(e) => Err((e, Vec::new())),
                     }
                 }
+                Action::Inputs { value } => match self.link.set_inputs(*value) {
+                    Ok(taken) => {
+                        let t = self.link.now();
+                        let o = self.oracle_now(t);
+                        self.oracle.set_inputs(o, *value);
+                        if !taken {
+                            rec.note = Some(
+                                "this transport cannot set digital inputs; only the reference took them"
+                                    .to_owned(),
+                            );
+                        }
+                        Ok(None)
+                    }
+                    Err(e) => Err((e, Vec::new())),
+                },
             };
             match result {
                 Ok(Some((ok, why))) => {

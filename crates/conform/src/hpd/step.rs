@@ -44,6 +44,9 @@ pub(crate) enum Action {
     PowerCycle,
     /// Sets the transport's bit rate to the one the reference now uses (after b42.3).
     BitRate,
+    /// Sets the digital inputs of the device and the reference (bit i = input i, manual
+    /// 3.8.1 b90); only on transports that can (`Caps::inputs`).
+    Inputs { value: u16 },
 }
 
 /// One step of a case.

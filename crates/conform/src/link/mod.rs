@@ -70,6 +70,8 @@ pub struct Caps {
     pub power_cycle: bool,
     /// The clock is virtual: waiting costs nothing.
     pub virtual_time: bool,
+    /// `set_inputs` drives the device's digital inputs (the simulator, manual 3.8.1 b90).
+    pub inputs: bool,
 }
 
 /// What `recover` did.
@@ -115,6 +117,13 @@ pub trait Link: Send {
 
     /// Switches the device off and on, when `caps().power_cycle`; false when not supported.
     fn power_cycle(&mut self) -> Result<bool, LinkError> {
+        Ok(false)
+    }
+
+    /// Sets the device's digital inputs (bit i = input i, manual 3.8.1 b90), when
+    /// `caps().inputs`; false when not supported.
+    fn set_inputs(&mut self, inputs: u16) -> Result<bool, LinkError> {
+        let _ = inputs;
         Ok(false)
     }
 

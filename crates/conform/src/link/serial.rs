@@ -7,6 +7,9 @@ use serialport::{DataBits, SerialPort, StopBits};
 use std::io::{ErrorKind, Read, Write};
 use std::time::Duration;
 
+/// Waits shorter than this are polls (Linux's default timer slack for a normal thread).
+pub(super) const TIMER_SLACK: Duration = Duration::from_micros(60);
+
 /// A serial port to the device under test.
 pub struct SerialLink {
     path: String,
@@ -108,7 +111,14 @@ impl Link for SerialLink {
         let mut buf = [0u8; 256];
         while let Some(left) = clock.until(deadline) {
             let p = self.port()?;
-            p.set_timeout(left.max(Duration::from_micros(100)))
+            // A wait shorter than the kernel's timer slack (50 µs) would sleep for the slack:
+            // such a check for late bytes polls without waiting instead.
+            let wait = if left < TIMER_SLACK {
+                Duration::ZERO
+            } else {
+                left
+            };
+            p.set_timeout(wait)
                 .map_err(|e| LinkError::Io(e.to_string()))?;
             match p.read(&mut buf) {
                 Ok(0) => {}

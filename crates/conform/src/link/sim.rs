@@ -16,6 +16,11 @@ pub trait SimDevice: Send {
     fn power_cycle(&mut self, now: Micros);
     /// A copy in the same state.
     fn clone_box(&self) -> Box<dyn SimDevice>;
+    /// The digital inputs change at `now` (manual 3.8.1 b90); false when the device has none.
+    fn set_inputs(&mut self, now: Micros, inputs: u16) -> bool {
+        let _ = (now, inputs);
+        false
+    }
 }
 
 impl SimDevice for Drive {
@@ -33,6 +38,10 @@ impl SimDevice for Drive {
     }
     fn clone_box(&self) -> Box<dyn SimDevice> {
         Box::new(self.clone())
+    }
+    fn set_inputs(&mut self, now: Micros, inputs: u16) -> bool {
+        Drive::set_inputs(self, now, inputs);
+        true
     }
 }
 
@@ -75,6 +84,7 @@ impl Link for SimLink {
             reset: true,
             power_cycle: true,
             virtual_time: true,
+            inputs: true,
         }
     }
 
@@ -119,6 +129,11 @@ impl Link for SimLink {
         // Outputs of the power-up (digital outputs) are not line bytes.
         while self.device.poll_output().is_some() {}
         Ok(true)
+    }
+
+    fn set_inputs(&mut self, inputs: u16) -> Result<bool, LinkError> {
+        let t = self.local(self.clock);
+        Ok(self.device.set_inputs(t, inputs))
     }
 
     fn recover(&mut self) -> Result<Recovered, LinkError> {

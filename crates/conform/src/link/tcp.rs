@@ -1,5 +1,7 @@
 //! `tcp:HOST:PORT`: a raw byte stream (ser2net, a simulator, a gateway).
 
+#[cfg(unix)]
+use super::serial::TIMER_SLACK;
 use super::{Caps, Chunk, Link, LinkError, Micros, Recovered, WallClock};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
@@ -91,6 +93,21 @@ impl Link for TcpLink {
         let mut buf = [0u8; 512];
         while let Some(left) = clock.until(deadline) {
             let s = self.stream()?;
+            // SO_RCVTIMEO counts in scheduler ticks (up to 4 ms): on Unix wait in poll, to the
+            // µs, and only poll below the timer slack (a check for late bytes).
+            #[cfg(unix)]
+            {
+                let wait = if left < TIMER_SLACK {
+                    Duration::ZERO
+                } else {
+                    left
+                };
+                let ready = crate::serve::port::readable(&*s, wait, "tcp")
+                    .map_err(|e| LinkError::Io(e.to_string()))?;
+                if !ready {
+                    continue;
+                }
+            }
             s.set_read_timeout(Some(left.max(Duration::from_micros(50))))
                 .map_err(|e| LinkError::io(&e))?;
             match s.read(&mut buf) {

@@ -15,10 +15,17 @@ details{margin:.3em 0;border-left:3px solid #ddd;padding-left:.6em}summary{curso
 
 /// The report as one HTML page.
 pub fn html(r: &Report) -> String {
+    html_with(r, "drivespec conform", "")
+}
+
+/// The report as one HTML page titled `tool` (`drivespec fuzz`), with `extra` (HTML, escaped
+/// by the caller) after the summary tables.
+pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>drivespec conform: {}</title><style>{STYLE}</style></head><body>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}: {}</title><style>{STYLE}</style></head><body>\n",
+        escape(tool),
         escape(&r.run.dut)
     );
     let s = &r.summary;
@@ -26,7 +33,8 @@ pub fn html(r: &Report) -> String {
     let families: Vec<String> = r.run.families.iter().map(|f| f.to_string()).collect();
     let _ = writeln!(
         h,
-        "<h1>drivespec conform {}: <span class=\"{verdict}\">{}</span></h1>",
+        "<h1>{} {}: <span class=\"{verdict}\">{}</span></h1>",
+        escape(tool),
         escape(&families.join(", ")),
         verdict.to_uppercase()
     );
@@ -66,6 +74,7 @@ pub fn html(r: &Report) -> String {
         );
     }
 
+    h.push_str(extra);
     h.push_str("<h2>Requirement coverage</h2>\n<table><tr><th>requirement</th><th>level</th><th>verdict</th><th>cases</th><th>text</th></tr>\n");
     for row in &r.coverage {
         let v = match row.verdict {
@@ -182,6 +191,16 @@ fn case(h: &mut String, c: &CaseReport) {
         "<p class=\"muted\">requirements: {}</p>",
         escape(&c.requirements.join(", "))
     );
+    // Positioning cases: position/speed/status over time, reference vs device (inline SVG).
+    for e in c
+        .evidence
+        .iter()
+        .filter(|e| e.action == crate::psd4xx::plot::ACTION)
+    {
+        if let Some(svg) = e.note.as_deref().and_then(crate::psd4xx::plot::svg) {
+            let _ = writeln!(h, "<p>{svg}</p>");
+        }
+    }
     if !c.evidence.is_empty() && c.status != Status::Pass {
         h.push_str("<table><tr><th>#</th><th>role</th><th>step</th><th>sent</th><th>reference</th><th>device</th><th>note</th></tr>\n");
         for e in &c.evidence {

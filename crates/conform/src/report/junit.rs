@@ -8,6 +8,12 @@ use std::fmt::Write as _;
 
 /// The report as JUnit XML.
 pub fn junit(r: &Report) -> String {
+    junit_with(r, "drivespec conform", &[])
+}
+
+/// The report as JUnit XML under the name `tool` (`drivespec fuzz`), with `properties` added
+/// to each test suite's properties.
+pub fn junit_with(r: &Report, tool: &str, properties: &[(String, String)]) -> String {
     let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let time = |cases: &[&CaseReport]| cases.iter().map(|c| c.wall_ms).sum::<f64>() / 1000.0;
@@ -26,7 +32,8 @@ pub fn junit(r: &Report) -> String {
     };
     let _ = writeln!(
         x,
-        "<testsuites name=\"drivespec conform\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"{}\" time=\"{:.3}\">",
+        "<testsuites name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"{}\" time=\"{:.3}\">",
+        escape(tool),
         all.len(),
         fails(&all),
         skips(&all),
@@ -50,6 +57,14 @@ pub fn junit(r: &Report) -> String {
             ("address", r.run.address.to_string()),
         ] {
             let _ = writeln!(x, "      <property name=\"{k}\" value=\"{}\"/>", escape(&v));
+        }
+        for (k, v) in properties {
+            let _ = writeln!(
+                x,
+                "      <property name=\"{}\" value=\"{}\"/>",
+                escape(k),
+                escape(v)
+            );
         }
         x.push_str("    </properties>\n");
         for c in cases {

@@ -6,8 +6,8 @@
 mod html;
 mod junit;
 
-pub use html::html;
-pub use junit::junit;
+pub use html::{html, html_with};
+pub use junit::{junit, junit_with};
 
 use crate::case::{Failure, Record};
 use drivespec_spec::{FamilyId, Level};

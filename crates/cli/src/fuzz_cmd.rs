@@ -1,0 +1,282 @@
+//! `drivespec fuzz`: argument parsing and printing around `drivespec_conform::fuzz`
+//! (crates/conform/README.md, "Fuzzing").
+
+use crate::{json, Context, Format, Outcome};
+use anyhow::{bail, Context as _, Result};
+use drivespec_conform::dut::Dut;
+use drivespec_conform::fuzz::{self, Options, Replay, ReplayOutcome};
+use drivespec_conform::suite::Settings;
+use drivespec_conform::Progress;
+use drivespec_spec::FamilyId;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Fuzz a device under test with sequences generated from the spec (exit 1 on findings).
+#[derive(clap::Args)]
+pub struct FuzzArgs {
+    /// Family: hpd (psd4xx and psx3xx are not available yet).
+    family: String,
+    /// Device under test: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS'.
+    #[arg(long, default_value = "sim")]
+    dut: String,
+    /// Device model.
+    #[arg(long)]
+    model: Option<String>,
+    /// Seed of the generator: the same seed sends the same sequences.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Sequences to run (default 1000 when --duration is not given).
+    #[arg(long, value_name = "N", conflicts_with = "duration")]
+    iterations: Option<u64>,
+    /// Wall-clock budget: 90s, 10m, 2h (a plain number is seconds).
+    #[arg(long, value_name = "TIME", value_parser = parse_duration)]
+    duration: Option<Duration>,
+    /// Folder of the reports and replay files.
+    #[arg(long, default_value = "reports/fuzz", value_name = "DIR")]
+    out: PathBuf,
+    /// Reproduce a replay file against the device (exit 1 if it still fails).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["minimize", "iterations", "duration"])]
+    replay: Option<PathBuf>,
+    /// Minimise a replay file against the device; writes DIR/<name>.min.json.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["iterations", "duration"])]
+    minimize: Option<PathBuf>,
+    /// Serial address of the device (HPD Pr27).
+    #[arg(long, default_value_t = 0)]
+    address: u8,
+    /// Extra time allowed for each answer on real transports, in ms.
+    #[arg(long, value_name = "MS")]
+    slack_ms: Option<u64>,
+    /// Distinct findings to minimise and keep (later ones are only counted).
+    #[arg(long, default_value_t = 20, value_name = "N")]
+    max_findings: usize,
+    /// Runs one minimisation may take.
+    #[arg(long, default_value_t = 400, value_name = "N")]
+    minimize_runs: u64,
+    /// No progress output.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `90s`, `10m`, `2h`, `500ms`, or seconds.
+fn parse_duration(text: &str) -> Result<Duration, String> {
+    let t = text.trim();
+    let split = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let n: u64 = num
+        .parse()
+        .map_err(|_| format!("{text:?}: expected a number with s, m, h or ms"))?;
+    let secs = |k: u64| Duration::from_secs(n.saturating_mul(k));
+    match unit.trim() {
+        "" | "s" => Ok(secs(1)),
+        "m" | "min" => Ok(secs(60)),
+        "h" => Ok(secs(3600)),
+        "ms" => Ok(Duration::from_millis(n)),
+        other => Err(format!("unknown unit {other:?} (s, m, h, ms)")),
+    }
+}
+
+/// Runs `drivespec fuzz`.
+pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
+    let Some(family) = FamilyId::parse(&args.family) else {
+        bail!("unknown family {:?}: hpd, psd4xx or psx3xx", args.family)
+    };
+    if family != FamilyId::Hpd {
+        return Err(fuzz::FuzzError::NotAvailable(family).into());
+    }
+    let dut: Dut = args.dut.parse()?;
+    let opts = Options {
+        family,
+        dut,
+        settings: Settings {
+            address: args.address,
+            seed: args.seed,
+            model: args.model,
+            slack_us: args.slack_ms.map(|ms| ms.saturating_mul(1000)),
+            bit_rate: None,
+        },
+        iterations: args.iterations,
+        duration: args.duration,
+        out_dir: args.out.clone(),
+        no_reports: false,
+        progress: if args.quiet {
+            Progress::Quiet
+        } else {
+            Progress::Auto
+        },
+        max_findings: args.max_findings,
+        minimize_runs: args.minimize_runs,
+        command: "drivespec fuzz".to_owned(),
+    };
+    let spec = ctx.spec()?;
+    if let Some(file) = &args.replay {
+        let r = Replay::load(file)?;
+        let out = fuzz::replay(&spec, &opts, &r)?;
+        print_replay(ctx, file, &out);
+        return Ok(if out.exit_code() == 0 {
+            Outcome::Pass
+        } else {
+            Outcome::Fail
+        });
+    }
+    if let Some(file) = &args.minimize {
+        let r = Replay::load(file)?;
+        return minimize(ctx, &opts, &spec, file, &r);
+    }
+    let mut err = std::io::stderr();
+    let summary = fuzz::run(&spec, &opts, &mut err)?;
+    let s = &summary.stats;
+    match ctx.format {
+        Format::Json => println!(
+            "{}",
+            json(&serde_json::json!({
+                "summary": summary.report.summary,
+                "sequences": s.sequences,
+                "inputs": s.inputs,
+                "findings": s.findings,
+                "reports": summary.written,
+            }))
+        ),
+        Format::Text => {
+            println!(
+                "{} sequence(s), {} input(s), {} finding(s) against {} (seed {}, stopped by {})",
+                s.sequences,
+                s.inputs,
+                s.findings.len(),
+                summary.report.run.transport,
+                s.seed,
+                s.stopped_by
+            );
+            for f in &s.findings {
+                println!(
+                    "{}: {} in {} step(s), seen {} time(s){}",
+                    f.id,
+                    f.signature,
+                    f.steps,
+                    f.occurrences,
+                    f.file
+                        .as_ref()
+                        .map(|p| format!("; replay: {p}"))
+                        .unwrap_or_default()
+                );
+            }
+            for w in &summary.written {
+                println!("report: {}", w.display());
+            }
+        }
+    }
+    Ok(if summary.exit_code() == 0 {
+        Outcome::Pass
+    } else {
+        Outcome::Fail
+    })
+}
+
+fn minimize(
+    ctx: &Context,
+    opts: &Options,
+    spec: &drivespec_spec::Spec,
+    file: &Path,
+    r: &Replay,
+) -> Result<Outcome> {
+    let Some(min) = fuzz::minimize(spec, opts, r)? else {
+        match ctx.format {
+            Format::Json => println!("{}", json(&serde_json::json!({ "fails": false }))),
+            Format::Text => println!(
+                "{}: passes against {}: nothing to minimise",
+                file.display(),
+                opts.dut
+            ),
+        }
+        return Ok(Outcome::Pass);
+    };
+    let stem = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "replay".to_owned());
+    let path = opts.out_dir.join(format!("{stem}.min.json"));
+    min.save(&path)
+        .with_context(|| format!("writing the minimised replay {}", path.display()))?;
+    let sig = min
+        .finding
+        .as_ref()
+        .map(|f| f.signature.clone())
+        .unwrap_or_default();
+    match ctx.format {
+        Format::Json => println!(
+            "{}",
+            json(&serde_json::json!({
+                "fails": true,
+                "signature": sig,
+                "steps": min.steps.len(),
+                "from": r.steps.len(),
+                "file": path,
+            }))
+        ),
+        Format::Text => println!(
+            "{sig}: {} step(s) (from {}) written to {}",
+            min.steps.len(),
+            r.steps.len(),
+            path.display()
+        ),
+    }
+    Ok(Outcome::Fail)
+}
+
+fn print_replay(ctx: &Context, file: &Path, out: &ReplayOutcome) {
+    let verdict = match &out.fault {
+        Some((class, sig, step)) => format!("fails at step {step}: {sig} ({})", class.as_str()),
+        None => "passes".to_owned(),
+    };
+    match ctx.format {
+        Format::Json => println!(
+            "{}",
+            json(&serde_json::json!({
+                "file": file,
+                "fails": out.fault.is_some(),
+                "signature": out.fault.as_ref().map(|f| f.1.clone()),
+                "same_as_recorded": out.same_as_recorded,
+                "same_finding": out.same_finding,
+                "exchanges": out.exchanges,
+            }))
+        ),
+        Format::Text => {
+            let hex = |h: &Option<String>| match h.as_deref() {
+                Some("") => "silence".to_owned(),
+                Some(h) => h.to_owned(),
+                None => "-".to_owned(),
+            };
+            for e in &out.exchanges {
+                let mark = match e.ok {
+                    Some(true) => "ok ",
+                    Some(false) => "BAD",
+                    None => "   ",
+                };
+                println!(
+                    "{mark} #{:<3} +{:>8} µs  sent {}",
+                    e.step,
+                    e.at_us,
+                    e.sent.as_deref().unwrap_or("-")
+                );
+                if e.expected.is_some() || e.got.is_some() {
+                    println!(
+                        "               reference {}\n               device    {}",
+                        hex(&e.expected),
+                        hex(&e.got)
+                    );
+                }
+                if let Some(n) = &e.note {
+                    println!("               note      {n}");
+                }
+            }
+            println!("{}: {verdict}", file.display());
+            println!(
+                "{}",
+                if out.same_as_recorded {
+                    "the exchange is byte for byte the recorded one"
+                } else {
+                    "the exchange differs from the recorded one"
+                }
+            );
+        }
+    }
+}

@@ -1,0 +1,196 @@
+//! `drivespec sim`: argument parsing and printing around `drivespec_conform::serve`.
+
+use crate::{Context, Outcome};
+use anyhow::{bail, Context as _, Result};
+use drivespec_conform::serve::{self, DeviceOptions, Faults, Options, ServedDevice, Stats, Stop};
+use drivespec_spec::FamilyId;
+use std::io::Write;
+use std::net::TcpListener;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// Serve a reference model to masters and PLC drivers on TCP, a pseudo-terminal or stdio.
+#[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("transport").required(true).args(["listen", "pty", "stdio"])))]
+pub struct SimArgs {
+    /// Device family: hpd (psd4xx and psx3xx are not available yet).
+    device: String,
+    /// Device model, matched forgivingly.
+    #[arg(long)]
+    model: Option<String>,
+    /// Serial address of the drive (HPD Pr27).
+    #[arg(long, default_value_t = 0, visible_alias = "address")]
+    addr: u8,
+    /// Baud-rate code (HPD Pr26); default: the delivery value.
+    #[arg(long, value_name = "C")]
+    baud_code: Option<u8>,
+    /// Listen on tcp:HOST:PORT, one client at a time (port 0: any free port; printed).
+    #[arg(long, value_name = "tcp:HOST:PORT")]
+    listen: Option<String>,
+    /// Create a pseudo-terminal and print its path, for serial clients.
+    #[arg(long)]
+    pty: bool,
+    /// Requests on stdin, answers on stdout (an `exec:` device under test).
+    #[arg(long)]
+    stdio: bool,
+    /// Probability (0–1) that an answer is not sent.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    drop_answers: f64,
+    /// Probability (0–1) that an answer with a checksum is sent with a wrong one.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    corrupt_checksums: f64,
+    /// Extra delay of every answer, in ms.
+    #[arg(long, value_name = "D", default_value_t = 0.0)]
+    delay_ms: f64,
+    /// Seed of the fault decisions.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Log every byte received and sent, with the time and the message in words (stderr).
+    #[arg(long)]
+    log: bool,
+    /// Take bytes whatever bit rate the client set on the pseudo-terminal.
+    #[arg(long)]
+    any_bit_rate: bool,
+    /// Stop after this many seconds.
+    #[arg(long, value_name = "S")]
+    time_limit: Option<f64>,
+}
+
+/// Runs `drivespec sim`.
+pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
+    let Some(family) = FamilyId::parse(&args.device) else {
+        bail!(
+            "unknown device {:?}: hpd (psd4xx and psx3xx are not available yet)",
+            args.device
+        );
+    };
+    if !(args.delay_ms.is_finite() && args.delay_ms >= 0.0) {
+        bail!("--delay-ms {}: a time in ms, 0 or more", args.delay_ms);
+    }
+    let time_limit = match args.time_limit {
+        Some(s) => match Duration::try_from_secs_f64(s) {
+            Ok(d) if !d.is_zero() => Some(d),
+            _ => bail!("--time-limit {s}: a time in seconds, more than 0"),
+        },
+        None => None,
+    };
+    let faults = Faults {
+        drop_answers: args.drop_answers,
+        corrupt_checksums: args.corrupt_checksums,
+        delay_us: (args.delay_ms * 1000.0).round() as u64,
+        seed: args.seed,
+    };
+    faults.check()?;
+    let spec = Arc::new(ctx.spec()?);
+    let device = serve::device(
+        spec,
+        family,
+        &DeviceOptions {
+            model: args.model,
+            address: args.addr,
+            baud_code: args.baud_code,
+        },
+    )?;
+    let opts = Options {
+        faults,
+        log: args.log,
+        time_limit,
+        max_clients: None,
+        check_bit_rate: !args.any_bit_rate,
+    };
+    let stop = Stop::new();
+    let stderr = std::io::stderr();
+    let mut log = stderr.lock();
+    let banner = |log: &mut dyn Write, device: &dyn ServedDevice, on: &str| {
+        let _ = writeln!(
+            log,
+            "drivespec sim: {} on {on}; {}",
+            device.describe(),
+            faults.describe()
+        );
+    };
+    let stats = if let Some(listen) = &args.listen {
+        let Some(addr) = listen.strip_prefix("tcp:") else {
+            bail!("--listen {listen:?}: expected tcp:HOST:PORT (e.g. tcp:127.0.0.1:4000)");
+        };
+        let listener =
+            TcpListener::bind(addr).with_context(|| format!("cannot listen on tcp:{addr}"))?;
+        let local = listener
+            .local_addr()
+            .with_context(|| format!("cannot listen on tcp:{addr}"))?;
+        // The one line on stdout: what a client connects to.
+        print_line(&local.to_string());
+        banner(&mut log, device.as_ref(), &format!("tcp:{local}"));
+        let _ = writeln!(
+            log,
+            "drivespec sim: test it with: drivespec conform {family} --dut tcp:{local}"
+        );
+        serve::serve_tcp(listener, device, &opts, &stop, &mut log)?
+    } else if args.pty {
+        serve_pty(device, &opts, &stop, &mut log, family, banner)?
+    } else {
+        banner(&mut log, device.as_ref(), "stdin/stdout");
+        serve::serve_stdio(device, &opts, &stop, &mut log)?
+    };
+    print_stats(&mut log, &stats);
+    Ok(Outcome::Pass)
+}
+
+#[cfg(unix)]
+fn serve_pty(
+    device: Box<dyn ServedDevice>,
+    opts: &Options,
+    stop: &Stop,
+    log: &mut dyn Write,
+    family: FamilyId,
+    banner: impl Fn(&mut dyn Write, &dyn ServedDevice, &str),
+) -> Result<Stats> {
+    let pty = serve::Pty::open(device.bit_rate())?;
+    // The one line on stdout: the path a serial client opens.
+    print_line(pty.path());
+    banner(log, device.as_ref(), pty.path());
+    let _ = writeln!(
+        log,
+        "drivespec sim: test it with: drivespec conform {family} --dut serial:{}",
+        pty.path()
+    );
+    Ok(serve::serve_pty(&pty, device, opts, stop, log)?)
+}
+
+#[cfg(not(unix))]
+fn serve_pty(
+    _device: Box<dyn ServedDevice>,
+    _opts: &Options,
+    _stop: &Stop,
+    _log: &mut dyn Write,
+    _family: FamilyId,
+    _banner: impl Fn(&mut dyn Write, &dyn ServedDevice, &str),
+) -> Result<Stats> {
+    bail!("--pty needs a Unix system (pseudo-terminals); use --listen or --stdio")
+}
+
+/// One line on stdout, flushed; a closed stdout (`| head -1`) is not an error.
+fn print_line(text: &str) {
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{text}");
+    let _ = out.flush();
+}
+
+fn print_stats(log: &mut dyn Write, s: &Stats) {
+    let _ = writeln!(
+        log,
+        "drivespec sim: served {:.1} s{}: {} byte(s) received ({} refused at a wrong bit rate), {} message(s) sent, {} dropped, {} corrupted, {} lost",
+        s.wall_us as f64 / 1e6,
+        if s.clients > 0 {
+            format!(", {} client(s)", s.clients)
+        } else {
+            String::new()
+        },
+        s.received,
+        s.refused,
+        s.sent,
+        s.dropped,
+        s.corrupted,
+        s.lost
+    );
+}

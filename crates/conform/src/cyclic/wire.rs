@@ -1,0 +1,424 @@
+//! Request and reply lines of `drivespec-cyclic/1` (README "Cyclic-exchange protocol").
+//!
+//! Words are separated by single blanks; numbers are decimal (times in µs, signed values with
+//! `-`); byte strings are hex without separators (upper or lower case). Unknown words give a
+//! [`WireError`], never a panic.
+
+use drivespec_psd4xx::model::LinkEvent;
+use std::fmt;
+
+/// Protocol version this runner speaks.
+pub const VERSION: u32 = 1;
+
+/// An environment injection (`ENV t NAME VALUE`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Env {
+    /// `power-cycle 0`: control voltage off and on again.
+    PowerCycle,
+    /// `jam 1|0`: the shaft is blocked / free (obstruction, 4.5).
+    Jam(bool),
+    /// `displace N`: the shaft is turned by hand by N increments at standstill.
+    Displace(i64),
+    /// `motor-voltage DV`: motor supply in 0.1 V.
+    MotorVoltage(u16),
+    /// `miss-steps N`: the next arrival lands N increments short.
+    MissSteps(i64),
+    /// `temperature C`: device temperature in °C.
+    Temperature(i16),
+    /// `link lost|connected|iops-bad|iops-good`: the bus connection (3.9).
+    Link(LinkEvent),
+}
+
+/// A request from the runner.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Request {
+    /// `HELLO drivespec-cyclic VERSION FAMILY MODEL`.
+    Hello {
+        /// Protocol version.
+        version: u32,
+        /// Device family (`psd4xx`).
+        family: String,
+        /// Device model the runner tests.
+        model: String,
+    },
+    /// `RESET`: a fresh device in its delivery state, clock at 0.
+    Reset,
+    /// `CYCLE T HEX`: one output image at time T; answered with the input image.
+    Cycle {
+        /// Virtual time (µs).
+        t: u64,
+        /// Output image.
+        image: Vec<u8>,
+    },
+    /// `ADVANCE T`: time passes without a bus cycle.
+    Advance {
+        /// Virtual time (µs).
+        t: u64,
+    },
+    /// `READ T INDEX`: an acyclic read record.
+    Read {
+        /// Virtual time (µs).
+        t: u64,
+        /// Record index.
+        index: u16,
+    },
+    /// `WRITE T INDEX HEX`: an acyclic write record (control byte first).
+    Write {
+        /// Virtual time (µs).
+        t: u64,
+        /// Record index.
+        index: u16,
+        /// Record data.
+        data: Vec<u8>,
+    },
+    /// `ENV T NAME VALUE`: an environment injection.
+    Env {
+        /// Virtual time (µs).
+        t: u64,
+        /// What changes.
+        env: Env,
+    },
+}
+
+/// A reply from the device side.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Reply {
+    /// `HELLO drivespec-cyclic VERSION NAME…`.
+    Hello {
+        /// Protocol version of the device side.
+        version: u32,
+        /// Free text naming the implementation.
+        name: String,
+    },
+    /// `OK`.
+    Ok,
+    /// `IN HEX`: the input image of a cycle.
+    In(Vec<u8>),
+    /// `DATA HEX`: the data of a read record.
+    Data(Vec<u8>),
+    /// `WRITTEN`: a write record was executed.
+    Written,
+    /// `IGNORED`: a write record was ignored (control byte 0).
+    Ignored,
+    /// `REFUSED CODE`: the record was refused with this PKW error code.
+    Refused(u32),
+    /// `MALFORMED`: the record data has the wrong length.
+    Malformed,
+    /// `SILENT`: no answer at all (switched off).
+    Silent,
+    /// `UNSUPPORTED`: the adapter cannot do this injection.
+    Unsupported,
+    /// `ERR TEXT`: the request line was not understood.
+    Err(String),
+}
+
+/// Why a line is not a valid request or reply.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{what}: {line:?}")]
+pub struct WireError {
+    /// The line.
+    pub line: String,
+    /// What is wrong.
+    pub what: String,
+}
+
+fn bad(line: &str, what: &str) -> WireError {
+    WireError {
+        line: line.chars().take(200).collect(),
+        what: what.to_owned(),
+    }
+}
+
+/// Hex without separators.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02X}")).collect()
+}
+
+/// Parses hex without separators.
+pub fn unhex(s: &str) -> Option<Vec<u8>> {
+    if s.len() % 2 != 0 || !s.is_ascii() {
+        return None;
+    }
+    (0..s.len())
+        .step_by(2)
+        .map(|i| s.get(i..i + 2).and_then(|p| u8::from_str_radix(p, 16).ok()))
+        .collect()
+}
+
+fn link_name(e: LinkEvent) -> &'static str {
+    match e {
+        LinkEvent::Lost => "lost",
+        LinkEvent::Connected => "connected",
+        LinkEvent::IopsBad => "iops-bad",
+        LinkEvent::IopsGood => "iops-good",
+    }
+}
+
+impl fmt::Display for Env {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Env::PowerCycle => f.write_str("power-cycle 0"),
+            Env::Jam(on) => write!(f, "jam {}", u8::from(*on)),
+            Env::Displace(n) => write!(f, "displace {n}"),
+            Env::MotorVoltage(dv) => write!(f, "motor-voltage {dv}"),
+            Env::MissSteps(n) => write!(f, "miss-steps {n}"),
+            Env::Temperature(c) => write!(f, "temperature {c}"),
+            Env::Link(e) => write!(f, "link {}", link_name(*e)),
+        }
+    }
+}
+
+impl fmt::Display for Request {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Request::Hello {
+                version,
+                family,
+                model,
+            } => write!(f, "HELLO drivespec-cyclic {version} {family} {model}"),
+            Request::Reset => f.write_str("RESET"),
+            Request::Cycle { t, image } => write!(f, "CYCLE {t} {}", hex(image)),
+            Request::Advance { t } => write!(f, "ADVANCE {t}"),
+            Request::Read { t, index } => write!(f, "READ {t} {index}"),
+            Request::Write { t, index, data } => write!(f, "WRITE {t} {index} {}", hex(data)),
+            Request::Env { t, env } => write!(f, "ENV {t} {env}"),
+        }
+    }
+}
+
+impl fmt::Display for Reply {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Reply::Hello { version, name } => write!(f, "HELLO drivespec-cyclic {version} {name}"),
+            Reply::Ok => f.write_str("OK"),
+            Reply::In(b) => write!(f, "IN {}", hex(b)),
+            Reply::Data(b) => write!(f, "DATA {}", hex(b)),
+            Reply::Written => f.write_str("WRITTEN"),
+            Reply::Ignored => f.write_str("IGNORED"),
+            Reply::Refused(c) => write!(f, "REFUSED {c}"),
+            Reply::Malformed => f.write_str("MALFORMED"),
+            Reply::Silent => f.write_str("SILENT"),
+            Reply::Unsupported => f.write_str("UNSUPPORTED"),
+            Reply::Err(t) => write!(f, "ERR {t}"),
+        }
+    }
+}
+
+fn num<T: std::str::FromStr>(line: &str, w: Option<&str>, what: &str) -> Result<T, WireError> {
+    w.and_then(|s| s.parse().ok())
+        .ok_or_else(|| bad(line, &format!("expected {what}")))
+}
+
+fn bytes(line: &str, w: Option<&str>) -> Result<Vec<u8>, WireError> {
+    w.and_then(unhex)
+        .ok_or_else(|| bad(line, "expected hex bytes"))
+}
+
+fn end(line: &str, mut words: std::str::SplitWhitespace<'_>) -> Result<(), WireError> {
+    match words.next() {
+        None => Ok(()),
+        Some(_) => Err(bad(line, "trailing words")),
+    }
+}
+
+impl Request {
+    /// Parses one request line (without its `\n`).
+    pub fn parse(line: &str) -> Result<Request, WireError> {
+        let mut w = line.split_whitespace();
+        let verb = w.next().unwrap_or("");
+        let r = match verb {
+            "HELLO" => {
+                if w.next() != Some("drivespec-cyclic") {
+                    return Err(bad(
+                        line,
+                        "expected HELLO drivespec-cyclic VERSION FAMILY MODEL",
+                    ));
+                }
+                let version = num(line, w.next(), "version")?;
+                let family = w.next().unwrap_or("").to_owned();
+                let model = w.next().unwrap_or("").to_owned();
+                Request::Hello {
+                    version,
+                    family,
+                    model,
+                }
+            }
+            "RESET" => Request::Reset,
+            "CYCLE" => Request::Cycle {
+                t: num(line, w.next(), "time")?,
+                image: bytes(line, w.next())?,
+            },
+            "ADVANCE" => Request::Advance {
+                t: num(line, w.next(), "time")?,
+            },
+            "READ" => Request::Read {
+                t: num(line, w.next(), "time")?,
+                index: num(line, w.next(), "index")?,
+            },
+            "WRITE" => Request::Write {
+                t: num(line, w.next(), "time")?,
+                index: num(line, w.next(), "index")?,
+                data: bytes(line, w.next())?,
+            },
+            "ENV" => {
+                let t = num(line, w.next(), "time")?;
+                let name = w.next().unwrap_or("");
+                let value = w.next();
+                let env = match name {
+                    "power-cycle" => Env::PowerCycle,
+                    "jam" => Env::Jam(num::<u8>(line, value, "0 or 1")? != 0),
+                    "displace" => Env::Displace(num(line, value, "increments")?),
+                    "motor-voltage" => Env::MotorVoltage(num(line, value, "0.1 V")?),
+                    "miss-steps" => Env::MissSteps(num(line, value, "increments")?),
+                    "temperature" => Env::Temperature(num(line, value, "°C")?),
+                    "link" => Env::Link(match value {
+                        Some("lost") => LinkEvent::Lost,
+                        Some("connected") => LinkEvent::Connected,
+                        Some("iops-bad") => LinkEvent::IopsBad,
+                        Some("iops-good") => LinkEvent::IopsGood,
+                        _ => return Err(bad(line, "expected lost|connected|iops-bad|iops-good")),
+                    }),
+                    _ => return Err(bad(line, "unknown environment name")),
+                };
+                Request::Env { t, env }
+            }
+            _ => return Err(bad(line, "unknown request")),
+        };
+        end(line, w)?;
+        Ok(r)
+    }
+}
+
+impl Reply {
+    /// Parses one reply line (without its `\n`).
+    pub fn parse(line: &str) -> Result<Reply, WireError> {
+        let mut w = line.split_whitespace();
+        let verb = w.next().unwrap_or("");
+        let r = match verb {
+            "HELLO" => {
+                if w.next() != Some("drivespec-cyclic") {
+                    return Err(bad(line, "expected HELLO drivespec-cyclic VERSION NAME"));
+                }
+                let version = num(line, w.next(), "version")?;
+                let name: Vec<&str> = w.by_ref().collect();
+                Reply::Hello {
+                    version,
+                    name: name.join(" "),
+                }
+            }
+            "OK" => Reply::Ok,
+            "IN" => Reply::In(bytes(line, w.next())?),
+            "DATA" => Reply::Data(bytes(line, w.next())?),
+            "WRITTEN" => Reply::Written,
+            "IGNORED" => Reply::Ignored,
+            "REFUSED" => Reply::Refused(num(line, w.next(), "error code")?),
+            "MALFORMED" => Reply::Malformed,
+            "SILENT" => Reply::Silent,
+            "UNSUPPORTED" => Reply::Unsupported,
+            "ERR" => {
+                let text: Vec<&str> = w.by_ref().collect();
+                Reply::Err(text.join(" "))
+            }
+            _ => return Err(bad(line, "unknown reply")),
+        };
+        end(line, w)?;
+        Ok(r)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requests_and_replies_round_trip() {
+        let reqs = [
+            Request::Hello {
+                version: 1,
+                family: "psd4xx".into(),
+                model: "PSD401-5V".into(),
+            },
+            Request::Reset,
+            Request::Cycle {
+                t: 10_000,
+                image: vec![0x10, 0xFF],
+            },
+            Request::Advance { t: 5 },
+            Request::Read { t: 1, index: 44 },
+            Request::Write {
+                t: 1,
+                index: 44,
+                data: vec![1, 0, 3],
+            },
+            Request::Env {
+                t: 2,
+                env: Env::Displace(-40),
+            },
+            Request::Env {
+                t: 2,
+                env: Env::Link(LinkEvent::IopsBad),
+            },
+        ];
+        for r in reqs {
+            assert_eq!(Request::parse(&r.to_string()), Ok(r));
+        }
+        let replies = [
+            Reply::Hello {
+                version: 1,
+                name: "my sim 2".into(),
+            },
+            Reply::In(vec![1, 2]),
+            Reply::Refused(17),
+            Reply::Err("what".into()),
+            Reply::Silent,
+        ];
+        for r in replies {
+            assert_eq!(Reply::parse(&r.to_string()), Ok(r));
+        }
+        // Arbitrary lines never panic (a deterministic generator over the protocol's words).
+        let words = [
+            "HELLO",
+            "drivespec-cyclic",
+            "CYCLE",
+            "IN",
+            "ENV",
+            "jam",
+            "link",
+            "-1",
+            "99999999999999999999",
+            "0A",
+            "zz",
+            "",
+            "READ",
+            "WRITE",
+            "REFUSED",
+            "é",
+        ];
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        for _ in 0..5000 {
+            let mut line = String::new();
+            for _ in 0..(x % 6) {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                line.push_str(words[(x % words.len() as u64) as usize]);
+                line.push(' ');
+            }
+            x = x.wrapping_add(1);
+            let _ = (Request::parse(&line), Reply::parse(&line));
+        }
+        for bad in [
+            "",
+            "CYCLE x 00",
+            "CYCLE 1 0",
+            "READ 1",
+            "ENV 1 warp 9",
+            "OK extra",
+        ] {
+            assert!(
+                Request::parse(bad).is_err() || Reply::parse(bad).is_err(),
+                "{bad}"
+            );
+        }
+    }
+}

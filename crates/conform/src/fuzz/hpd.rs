@@ -1,0 +1,314 @@
+//! The HPD fuzz target: sequences from [`super::hpd_gen`], run through the conformance
+//! session ([`HpdSession`]) so every answer is judged exactly as `drivespec conform` judges it
+//! (the reference drive fed the same bytes at the same times, manual chapter 4).
+//!
+//! A failing step is a crash when the transport failed (the process exited, the connection
+//! closed), a hang when the device was silent where the reference answers and stays silent
+//! to a liveness probe (a read of Pr33), and a mismatch otherwise.
+
+use super::engine::{Fault, Target, Trial};
+use super::hpd_gen::HpdGen;
+use super::replay::{Action, Compare, FindingClass, Start, Step};
+use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use crate::hpd::step::{Action as HAction, Compare as HCompare, HpdCase, Step as HStep};
+use crate::hpd::{HpdSession, HpdSuite};
+use crate::link::{Caps, Link, LinkError, Recovered};
+use crate::rng::Rng;
+use crate::suite::SetupError;
+use drivespec_hpd::memory::Slot;
+use drivespec_hpd::{FrameRules, Message};
+use drivespec_spec::{Family, FamilyId, Level};
+
+/// The HPD target on one device under test.
+pub(crate) struct HpdTarget<'a, 's> {
+    family: &'s Family,
+    rules: FrameRules,
+    session: HpdSession<'a, 's>,
+    gen: HpdGen<'a, 's>,
+    caps: Caps,
+    probe: Vec<Step>,
+    /// Whether `recover` restarts the device (exec) rather than reconnecting (tcp, serial);
+    /// None until tried.
+    restarts: Option<bool>,
+    /// The session restarted the device after a transport error in the last run: it is in
+    /// its start state already.
+    clean: bool,
+}
+
+impl<'a, 's> HpdTarget<'a, 's> {
+    /// A target on `link`, with cases and the reference from `suite`.
+    pub(crate) fn new(
+        suite: &'a HpdSuite<'s>,
+        link: Box<dyn Link>,
+    ) -> Result<HpdTarget<'a, 's>, SetupError> {
+        let caps = link.caps();
+        let rules =
+            FrameRules::from_spec(suite.spec()).map_err(|e| SetupError::Spec(e.to_string()))?;
+        let mut gen = HpdGen::new(suite, caps).map_err(SetupError::Spec)?;
+        let probe = gen.probe();
+        Ok(HpdTarget {
+            family: suite.family(),
+            rules,
+            session: suite.session(link),
+            gen,
+            caps,
+            probe,
+            restarts: None,
+            clean: false,
+        })
+    }
+
+    fn case(&self, steps: &[Step]) -> (CaseInfo, HpdCase) {
+        let hsteps: Vec<HStep> = steps.iter().map(to_hpd).collect();
+        let info = CaseInfo {
+            id: "hpd/fuzz/sequence".to_owned(),
+            family: FamilyId::Hpd,
+            requirements: Vec::new(),
+            level: Level::Must,
+            description: "a fuzz sequence".to_owned(),
+            steps: steps.iter().map(|s| s.text.clone()).collect(),
+        };
+        let case = HpdCase {
+            needs_power_cycle: steps.iter().any(|s| s.action == Action::PowerCycle),
+            touched: self.touched(steps),
+            steps: hsteps,
+        };
+        (info, case)
+    }
+
+    /// Parameter slots the steps may change (read back after a failure on transports that
+    /// cannot reset, as the conformance runner does).
+    fn touched(&self, steps: &[Step]) -> Vec<Slot> {
+        let mut out: Vec<Slot> = Vec::new();
+        for s in steps {
+            let Some(bytes) = s.action.bytes() else {
+                continue;
+            };
+            let (par, len) = match drivespec_hpd::parse(&self.rules, bytes) {
+                Ok(Message::WriteParam { par, data, .. } | Message::Broadcast { par, data }) => {
+                    (par, data.len())
+                }
+                Ok(Message::BitChange { par, .. }) => (par, 1),
+                _ => continue,
+            };
+            for i in 0..len {
+                let Some(a) = par.checked_add(i) else { break };
+                let Some(p) = self.family.parameter_at_address(u32::from(a)) else {
+                    continue;
+                };
+                let (Some(addr), Some(size)) = (p.address, p.size) else {
+                    continue;
+                };
+                let (Ok(addr), Ok(size)) = (u8::try_from(addr), u8::try_from(size)) else {
+                    continue;
+                };
+                let slot = Slot { addr, size };
+                if !out.contains(&slot) {
+                    out.push(slot);
+                }
+            }
+        }
+        out
+    }
+
+    fn run_raw(&mut self, steps: &[Step]) -> CaseRun {
+        let (info, case) = self.case(steps);
+        self.session.run_case(&info, &case, false)
+    }
+
+    /// What kind of message a step sends, for signatures.
+    fn kind(&self, s: Option<&Step>) -> String {
+        match s.map(|s| &s.action) {
+            Some(Action::Exchange { bytes, .. }) => {
+                match drivespec_hpd::parse(&self.rules, bytes) {
+                    Ok(m) => m.kind().spec_name().to_owned(),
+                    Err(_) => "malformed".to_owned(),
+                }
+            }
+            Some(Action::Send { .. }) => "send".to_owned(),
+            Some(Action::Listen { .. } | Action::ListenTimeout | Action::ListenHalfTimeout) => {
+                "listen".to_owned()
+            }
+            Some(Action::PowerCycle) => "power-cycle".to_owned(),
+            Some(Action::Inputs { .. }) => "inputs".to_owned(),
+            Some(Action::BitRate) => "bit-rate".to_owned(),
+            None => "start".to_owned(),
+        }
+    }
+}
+
+/// A fuzz step as a conformance step (judged).
+fn to_hpd(s: &Step) -> HStep {
+    let action = match &s.action {
+        Action::Exchange {
+            bytes,
+            compare,
+            silence_ok,
+        } => HAction::Exchange {
+            bytes: bytes.clone(),
+            compare: match compare {
+                Compare::Exact => HCompare::Exact,
+                Compare::Mask(m) => HCompare::Mask(*m),
+                Compare::Near(t) => HCompare::Near { tolerance: *t },
+            },
+            silence_ok: *silence_ok,
+            golden: None,
+        },
+        Action::Send { bytes } => HAction::Send {
+            bytes: bytes.clone(),
+        },
+        Action::Listen { us } => HAction::Listen { us: *us },
+        Action::ListenTimeout => HAction::ListenTimeout,
+        Action::ListenHalfTimeout => HAction::ListenHalfTimeout,
+        Action::PowerCycle => HAction::PowerCycle,
+        Action::Inputs { value } => HAction::Inputs { value: *value },
+        Action::BitRate => HAction::BitRate,
+    };
+    HStep {
+        role: Role::Check,
+        action,
+        text: s.text.clone(),
+        requirements: s.requirements.clone(),
+    }
+}
+
+impl Target for HpdTarget<'_, '_> {
+    fn family(&self) -> FamilyId {
+        FamilyId::Hpd
+    }
+
+    fn describe(&self) -> String {
+        crate::suite::Session::describe(&self.session)
+    }
+
+    fn caps(&self) -> Caps {
+        self.caps
+    }
+
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
+        self.gen.sequence(rng)
+    }
+
+    fn fresh(&mut self) -> Result<Start, LinkError> {
+        if self.caps.reset {
+            return Ok(if self.session.reset()? {
+                Start::Fresh
+            } else {
+                Start::AsIs
+            });
+        }
+        if self.restarts == Some(false) {
+            return Ok(Start::AsIs);
+        }
+        if std::mem::take(&mut self.clean) {
+            self.warm_up();
+            self.session.restart_reference();
+            return Ok(Start::Fresh);
+        }
+        let r = self.session.recover()?;
+        self.restarts = Some(r == Recovered::Fresh);
+        self.warm_up();
+        if r == Recovered::Fresh {
+            self.session.restart_reference();
+        }
+        Ok(match r {
+            Recovered::Fresh => Start::Fresh,
+            Recovered::Same => Start::AsIs,
+        })
+    }
+
+    fn warm_up(&mut self) {
+        if self.caps.virtual_time {
+            return;
+        }
+        let probe: Vec<u8> = self
+            .probe
+            .iter()
+            .find_map(|s| s.action.bytes())
+            .map(<[u8]>::to_vec)
+            .unwrap_or_default();
+        if !probe.is_empty() {
+            // Bytes of the answer that come after are dropped before the next request.
+            let _ = self.session.wake(&probe);
+        }
+    }
+
+    fn run(&mut self, steps: &[Step]) -> Trial {
+        self.clean = false;
+        let mut run = self.run_raw(steps);
+        let Outcome::Fail(failure) = run.outcome.clone() else {
+            return Trial { run, fault: None };
+        };
+        let rec = failure.step.and_then(|i| run.evidence.get(i)).cloned();
+        let step = rec.as_ref().map_or(0, |r| r.step);
+        let kind = self.kind(steps.get(step));
+        let transport = rec
+            .as_ref()
+            .and_then(|r| r.note.as_deref())
+            .is_some_and(|n| n.starts_with("transport:"))
+            || rec.is_none();
+        let exp_silent = rec
+            .as_ref()
+            .and_then(|r| r.expected.as_ref())
+            .is_none_or(|a| a.is_silence());
+        let got_silent = rec
+            .as_ref()
+            .and_then(|r| r.got.as_ref())
+            .is_none_or(|a| a.is_silence());
+        let (class, detail) = if transport {
+            // The session restarted a process that died (a reconnected socket is not new).
+            self.clean = self.restarts == Some(true);
+            (FindingClass::Crash, String::new())
+        } else if !exp_silent && got_silent {
+            // Still talking? A read the reference answers.
+            let probe = self.probe.clone();
+            let p = self.run_raw(&probe);
+            let base = steps.len();
+            let hung = p.outcome.failed();
+            for mut r in p.evidence {
+                r.step += base;
+                r.note = Some(match r.note {
+                    Some(n) => format!("liveness probe; {n}"),
+                    None => "liveness probe".to_owned(),
+                });
+                run.evidence.push(r);
+            }
+            if hung {
+                (FindingClass::Hang, String::new())
+            } else {
+                (FindingClass::Mismatch, "/silence-where-answer".to_owned())
+            }
+        } else if exp_silent && !got_silent {
+            (FindingClass::Mismatch, "/answer-where-silent".to_owned())
+        } else {
+            (FindingClass::Mismatch, "/different-answer".to_owned())
+        };
+        let signature = format!("{}/{kind}{detail}", class.as_str());
+        Trial {
+            run,
+            fault: Some(Fault {
+                class,
+                step,
+                signature,
+                failure,
+            }),
+        }
+    }
+
+    fn requirement(&self, id: &str) -> Option<RequirementRef> {
+        self.family.requirement(id).map(|r| RequirementRef {
+            id: r.id.clone(),
+            level: r.level,
+            text: r.text.clone(),
+        })
+    }
+
+    fn requirement_ids(&self) -> Vec<(String, Level)> {
+        self.family
+            .requirements
+            .iter()
+            .filter(|r| r.level != Level::Informative)
+            .map(|r| (r.id.clone(), r.level))
+            .collect()
+    }
+}

@@ -1,0 +1,564 @@
+//! Fuzz inputs and the replay file (`drivespec-fuzz-replay/1`, JSON; described in
+//! `crates/conform/README.md`, "Fuzzing"): the steps of a sequence, what each exchange gave
+//! when the file was written, and the finding it reproduces.
+//!
+//! Loading never panics: unknown keys, a wrong format name, bad hex or a step without the
+//! fields its action needs are errors naming the step.
+
+use crate::case::Record;
+use crate::link::Micros;
+use drivespec_spec::hex::{parse_hex, to_hex};
+use drivespec_spec::FamilyId;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Name and version of the replay format (README "Replay files").
+pub const REPLAY_FORMAT: &str = "drivespec-fuzz-replay/1";
+
+/// How an answer is compared with the reference's (as `conform` does, README "Cases").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Compare {
+    /// Byte for byte, silence included.
+    #[default]
+    Exact,
+    /// The same frame; data bits outside the mask (little-endian) are not compared.
+    Mask(u32),
+    /// The same frame; the data as a value within ± the tolerance (timers).
+    Near(i64),
+}
+
+/// What one step does (README "Replay files", key `do`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Action {
+    /// Sends bytes and judges the answers of the device and the reference within the answer
+    /// window (manual 4.1 time-out, answer delay, slack).
+    Exchange {
+        /// Bytes on the line.
+        bytes: Vec<u8>,
+        /// How the answers are compared.
+        compare: Compare,
+        /// Silence from the device is accepted too.
+        silence_ok: bool,
+    },
+    /// Sends bytes without waiting (the first part of a split frame).
+    Send {
+        /// Bytes on the line.
+        bytes: Vec<u8>,
+    },
+    /// Listens for `us` µs and judges what comes (normally nothing).
+    Listen {
+        /// How long.
+        us: Micros,
+    },
+    /// Listens past the message time-out in force (manual 4, Pr26).
+    ListenTimeout,
+    /// Listens for half the message time-out in force.
+    ListenHalfTimeout,
+    /// Switches the device and the reference off and on (sim only).
+    PowerCycle,
+    /// Sets the digital inputs, bit i = input i (manual 3.8.1 b90; sim only).
+    Inputs {
+        /// The inputs.
+        value: u16,
+    },
+    /// Follows the bit rate the reference uses now (serial ports, after b42.3).
+    BitRate,
+}
+
+impl Action {
+    /// The bytes the step puts on the line, if any.
+    pub fn bytes(&self) -> Option<&[u8]> {
+        match self {
+            Action::Exchange { bytes, .. } | Action::Send { bytes } => Some(bytes),
+            _ => None,
+        }
+    }
+
+    /// The same action with other bytes (exchanges and sends only).
+    pub fn with_bytes(&self, new: Vec<u8>) -> Action {
+        match self {
+            Action::Exchange {
+                compare,
+                silence_ok,
+                ..
+            } => Action::Exchange {
+                bytes: new,
+                compare: *compare,
+                silence_ok: *silence_ok,
+            },
+            Action::Send { .. } => Action::Send { bytes: new },
+            other => other.clone(),
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            Action::Exchange { .. } => "exchange",
+            Action::Send { .. } => "send",
+            Action::Listen { .. } => "listen",
+            Action::ListenTimeout => "listen-timeout",
+            Action::ListenHalfTimeout => "listen-half-timeout",
+            Action::PowerCycle => "power-cycle",
+            Action::Inputs { .. } => "inputs",
+            Action::BitRate => "bit-rate",
+        }
+    }
+}
+
+/// One input of a fuzz sequence.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Step {
+    /// What it does.
+    pub action: Action,
+    /// The generator class it came from (`out-of-range-write`, `bad-checksum`, …).
+    pub class: String,
+    /// One line.
+    pub text: String,
+    /// Requirement IDs the step exercises.
+    pub requirements: Vec<String>,
+}
+
+/// What kind of problem a finding is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FindingClass {
+    /// The device answered differently from the reference (other bytes, an answer where the
+    /// reference is silent, silence where it answers while the device still answers others).
+    Mismatch,
+    /// The device stopped answering: silent where the reference answers, and silent to a
+    /// liveness probe after it.
+    Hang,
+    /// The transport failed: the process exited, the connection closed, i/o failed.
+    Crash,
+}
+
+impl FindingClass {
+    /// The name used in reports and signatures.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FindingClass::Mismatch => "mismatch",
+            FindingClass::Hang => "hang",
+            FindingClass::Crash => "crash",
+        }
+    }
+}
+
+/// How the device must be at the start of a replay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Start {
+    /// In its start state: reset (sim) or restarted (exec) before the first step.
+    Fresh,
+    /// As it is (tcp, serial: the device cannot be reset from here).
+    AsIs,
+}
+
+/// The finding a replay reproduces.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FindingInfo {
+    /// Mismatch, hang or crash.
+    pub class: FindingClass,
+    /// `class/message-kind/detail`: findings with the same signature are one bug.
+    pub signature: String,
+    /// One line: what went wrong at the failing step.
+    pub message: String,
+    /// Index of the failing step in `steps`.
+    pub step: usize,
+    /// Requirements the failing step and the reference's answer cover.
+    pub requirements: Vec<String>,
+    /// Sequence number in the run that found it.
+    pub sequence: u64,
+    /// Steps before minimisation.
+    pub original_steps: usize,
+    /// Runs the minimisation took.
+    pub minimisation_runs: u64,
+    /// Whether the minimised sequence was confirmed from the start state.
+    pub reproduced: bool,
+}
+
+/// What one step gave when the file was written (hex; empty: silence).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Observed {
+    /// Step index.
+    pub step: usize,
+    /// Time of the step from the start of the replay (µs on the transport's clock).
+    pub at_us: Micros,
+    /// Bytes sent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sent: Option<String>,
+    /// The reference's answer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expected: Option<String>,
+    /// The device's answer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub got: Option<String>,
+    /// Whether the step matched (absent: not judged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ok: Option<bool>,
+    /// Remarks (transport errors, the liveness probe).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+impl Observed {
+    /// The observation of an evidence record, with times from `t0`.
+    pub fn of(r: &Record, t0: Micros) -> Observed {
+        Observed {
+            step: r.step,
+            at_us: r.at_us.saturating_sub(t0),
+            sent: r.sent.clone(),
+            expected: r.expected.as_ref().map(|a| a.hex.clone()),
+            got: r.got.as_ref().map(|a| a.hex.clone()),
+            ok: r.ok,
+            note: r.note.clone(),
+        }
+    }
+
+    /// Whether two observations show the same bytes and verdict (times and notes aside).
+    pub fn same_exchange(&self, other: &Observed) -> bool {
+        self.step == other.step
+            && self.sent == other.sent
+            && self.expected == other.expected
+            && self.got == other.got
+            && self.ok == other.ok
+    }
+}
+
+/// A replay file: the sequence, where it was found, and what it gave.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Replay {
+    /// The family.
+    pub family: FamilyId,
+    /// The device under test it was found on (informative).
+    pub dut: String,
+    /// Device address (HPD Pr27).
+    pub address: u8,
+    /// Device model.
+    pub model: Option<String>,
+    /// Bit rate (serial).
+    pub bit_rate: Option<u32>,
+    /// Seed of the run that found it.
+    pub seed: u64,
+    /// Start state.
+    pub start: Start,
+    /// The finding (absent: a plain sequence).
+    pub finding: Option<FindingInfo>,
+    /// The inputs, in order.
+    pub steps: Vec<Step>,
+    /// What each step gave when the file was written.
+    pub exchanges: Vec<Observed>,
+}
+
+/// Why a replay file cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReplayError {
+    /// The file cannot be read or written.
+    #[error("{file}: {why}")]
+    Io {
+        /// The file.
+        file: String,
+        /// Why.
+        why: String,
+    },
+    /// The text is not a replay file.
+    #[error("{file}: {why}")]
+    Format {
+        /// The file.
+        file: String,
+        /// What is wrong (with the step index where it applies).
+        why: String,
+    },
+}
+
+/// The file form of [`Replay`].
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReplayFile {
+    format: String,
+    family: FamilyId,
+    dut: String,
+    address: u8,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    model: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    bit_rate: Option<u32>,
+    seed: u64,
+    start: Start,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    finding: Option<FindingInfo>,
+    steps: Vec<StepFile>,
+    #[serde(default)]
+    exchanges: Vec<Observed>,
+}
+
+/// The file form of [`Step`]: `do` names the action; the other keys are the action's.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StepFile {
+    #[serde(rename = "do")]
+    action: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    hex: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    compare: Option<Compare>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    silence_ok: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    us: Option<Micros>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    value: Option<u16>,
+    #[serde(default)]
+    class: String,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    text: String,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    requirements: Vec<String>,
+}
+
+impl StepFile {
+    fn of(s: &Step) -> StepFile {
+        let mut f = StepFile {
+            action: s.action.name().to_owned(),
+            hex: s.action.bytes().map(to_hex),
+            compare: None,
+            silence_ok: false,
+            us: None,
+            value: None,
+            class: s.class.clone(),
+            text: s.text.clone(),
+            requirements: s.requirements.clone(),
+        };
+        match &s.action {
+            Action::Exchange {
+                compare,
+                silence_ok,
+                ..
+            } => {
+                f.compare = Some(*compare);
+                f.silence_ok = *silence_ok;
+            }
+            Action::Listen { us } => f.us = Some(*us),
+            Action::Inputs { value } => f.value = Some(*value),
+            _ => {}
+        }
+        f
+    }
+
+    fn step(self, index: usize) -> Result<Step, String> {
+        let bytes = || -> Result<Vec<u8>, String> {
+            let hex = self
+                .hex
+                .as_deref()
+                .ok_or_else(|| format!("step {index}: `{}` needs `hex`", self.action))?;
+            parse_hex(hex).map_err(|e| format!("step {index}: hex: {e}"))
+        };
+        let action = match self.action.as_str() {
+            "exchange" => Action::Exchange {
+                bytes: bytes()?,
+                compare: self.compare.unwrap_or_default(),
+                silence_ok: self.silence_ok,
+            },
+            "send" => Action::Send { bytes: bytes()? },
+            "listen" => Action::Listen {
+                us: self
+                    .us
+                    .ok_or_else(|| format!("step {index}: `listen` needs `us`"))?,
+            },
+            "listen-timeout" => Action::ListenTimeout,
+            "listen-half-timeout" => Action::ListenHalfTimeout,
+            "power-cycle" => Action::PowerCycle,
+            "inputs" => Action::Inputs {
+                value: self
+                    .value
+                    .ok_or_else(|| format!("step {index}: `inputs` needs `value`"))?,
+            },
+            "bit-rate" => Action::BitRate,
+            other => {
+                return Err(format!(
+                    "step {index}: unknown action {other:?} (exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate)"
+                ))
+            }
+        };
+        Ok(Step {
+            action,
+            class: self.class,
+            text: self.text,
+            requirements: self.requirements,
+        })
+    }
+}
+
+impl Replay {
+    /// The file text (pretty JSON, one key per line).
+    pub fn to_json(&self) -> String {
+        let file = ReplayFile {
+            format: REPLAY_FORMAT.to_owned(),
+            family: self.family,
+            dut: self.dut.clone(),
+            address: self.address,
+            model: self.model.clone(),
+            bit_rate: self.bit_rate,
+            seed: self.seed,
+            start: self.start,
+            finding: self.finding.clone(),
+            steps: self.steps.iter().map(StepFile::of).collect(),
+            exchanges: self.exchanges.clone(),
+        };
+        serde_json::to_string_pretty(&file)
+            .map(|mut s| {
+                s.push('\n');
+                s
+            })
+            .unwrap_or_else(|e| format!("{{\"error\": {:?}}}\n", e.to_string()))
+    }
+
+    /// Parses the file text; `file` names it in errors.
+    pub fn from_json(text: &str, file: &str) -> Result<Replay, ReplayError> {
+        let bad = |why: String| ReplayError::Format {
+            file: file.to_owned(),
+            why,
+        };
+        let f: ReplayFile = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+        if f.format != REPLAY_FORMAT {
+            return Err(bad(format!(
+                "format {:?}, expected {REPLAY_FORMAT:?}",
+                f.format
+            )));
+        }
+        let steps = f
+            .steps
+            .into_iter()
+            .enumerate()
+            .map(|(i, s)| s.step(i))
+            .collect::<Result<Vec<Step>, String>>()
+            .map_err(bad)?;
+        if let Some(fi) = &f.finding {
+            if fi.step >= steps.len() {
+                return Err(bad(format!(
+                    "finding.step {} but only {} step(s)",
+                    fi.step,
+                    steps.len()
+                )));
+            }
+        }
+        Ok(Replay {
+            family: f.family,
+            dut: f.dut,
+            address: f.address,
+            model: f.model,
+            bit_rate: f.bit_rate,
+            seed: f.seed,
+            start: f.start,
+            finding: f.finding,
+            steps,
+            exchanges: f.exchanges,
+        })
+    }
+
+    /// Reads a replay file.
+    pub fn load(path: &Path) -> Result<Replay, ReplayError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ReplayError::Io {
+            file: file.clone(),
+            why: e.to_string(),
+        })?;
+        Replay::from_json(&text, &file)
+    }
+
+    /// Writes the file atomically.
+    pub fn save(&self, path: &Path) -> Result<(), ReplayError> {
+        crate::report::write_atomic(path, &self.to_json()).map_err(|e| ReplayError::Io {
+            file: path.display().to_string(),
+            why: e.to_string(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+
+    fn sample() -> Replay {
+        Replay {
+            family: FamilyId::Hpd,
+            dut: "sim".into(),
+            address: 0,
+            model: None,
+            bit_rate: None,
+            seed: 7,
+            start: Start::Fresh,
+            finding: None,
+            steps: vec![
+                Step {
+                    action: Action::Send {
+                        bytes: vec![0x7E, 0x80],
+                    },
+                    class: "split-timeout".into(),
+                    text: "first part".into(),
+                    requirements: vec![],
+                },
+                Step {
+                    action: Action::ListenTimeout,
+                    class: "split-timeout".into(),
+                    text: String::new(),
+                    requirements: vec![],
+                },
+                Step {
+                    action: Action::Exchange {
+                        bytes: vec![0x02, 0xC6, 0x48],
+                        compare: Compare::Mask(0xFF00),
+                        silence_ok: false,
+                    },
+                    class: "split-timeout".into(),
+                    text: "rest".into(),
+                    requirements: vec!["HPD-FRAME-020".into()],
+                },
+                Step {
+                    action: Action::Inputs { value: 5 },
+                    class: "inputs".into(),
+                    text: String::new(),
+                    requirements: vec![],
+                },
+                Step {
+                    action: Action::Listen { us: 6144 },
+                    class: "listen".into(),
+                    text: String::new(),
+                    requirements: vec![],
+                },
+            ],
+            exchanges: vec![],
+        }
+    }
+
+    #[test]
+    fn the_readme_example_loads() {
+        let readme = include_str!("../../README.md");
+        let from = readme.find("### Replay files").unwrap();
+        let block = readme[from..].split("```json").nth(1).unwrap();
+        let json = block.split("```").next().unwrap();
+        let r = Replay::from_json(json, "README.md").unwrap();
+        assert_eq!(r.steps.len(), 3);
+        assert_eq!(r.steps[1].action, Action::ListenTimeout);
+        assert_eq!(r.start, Start::Fresh);
+    }
+
+    #[test]
+    fn round_trips_and_rejects_bad_files() {
+        let r = sample();
+        let text = r.to_json();
+        assert_eq!(Replay::from_json(&text, "x").unwrap(), r);
+        assert!(text.contains("\"do\": \"listen-timeout\""));
+        let bad = text.replace("listen-timeout", "nap");
+        assert!(Replay::from_json(&bad, "x").is_err());
+        let bad = text.replace("\"seed\"", "\"sead\"");
+        assert!(Replay::from_json(&bad, "x").is_err());
+        let bad = text.replace(REPLAY_FORMAT, "drivespec-fuzz-replay/0");
+        assert!(Replay::from_json(&bad, "x").is_err());
+        assert!(Replay::from_json("{", "x").is_err());
+    }
+}

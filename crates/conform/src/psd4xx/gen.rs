@@ -1,0 +1,1243 @@
+//! Case generation for the PSD4xx suite: data-driven from the spec's parameter table (ranges
+//! per model), PKW command and error tables, control-word values and `sequence` vectors, plus
+//! hand-written positioning and status cases.
+
+use crate::case::{CaseInfo, Role};
+use crate::cyclic::Env;
+use drivespec_psd4xx::model::{Drive, LinkEvent, RecordRequest};
+use drivespec_psd4xx::{PkwRequest, PkwRules, RecordWrite, Request, Rules, Width};
+use drivespec_spec::{Access, DeviceModel, Family, FamilyId, Level, Parameter, VectorKind};
+
+/// One action of a case; both the device and the reference get exactly the same inputs.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Action {
+    /// New process data (absent: unchanged), then one cycle.
+    Process {
+        /// Control word.
+        control: Option<u16>,
+        /// Target value.
+        target: Option<i32>,
+    },
+    /// A PKW block; cycles until the reference answers it (at most [`PKW_MAX_CYCLES`]).
+    Pkw(PkwRequest),
+    /// New control word (absent: unchanged) and a target relative to the reference's actual
+    /// position, then one cycle.
+    Offset {
+        /// Control word.
+        control: Option<u16>,
+        /// Target minus actual position.
+        offset: i64,
+    },
+    /// Cycles with the outputs unchanged.
+    Hold(u32),
+    /// Cycles until the reference is running (`true`) or at standstill (`false`).
+    Until {
+        /// Wait for status bit "drive is running" set (true) or clear (false).
+        running: bool,
+        /// Most cycles.
+        max: u32,
+    },
+    /// An acyclic record.
+    Record(RecordRequest),
+    /// An environment injection.
+    Env(Env),
+}
+
+/// Most cycles a PKW command is repeated before the case moves on (PSD-PKW-002).
+pub(crate) const PKW_MAX_CYCLES: u32 = 8;
+
+/// One step: who it is for, one line, what it does.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct StepDef {
+    /// Setup, check or cleanup.
+    pub role: Role,
+    /// One line.
+    pub text: String,
+    /// What to do.
+    pub action: Action,
+}
+
+/// Declared tolerances of a case (physics); everything else is exact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct Tolerance {
+    /// A device sample may match a reference sample this many cycles earlier or later.
+    pub cycles: u32,
+    /// Actual position, increments.
+    pub position: i64,
+    /// Speed, rpm.
+    pub speed: i64,
+}
+
+/// Tolerance of the motion cases: ±3 cycles, ±20 increments, ±2 rpm.
+const MOTION: Tolerance = Tolerance {
+    cycles: 3,
+    position: 20,
+    speed: 2,
+};
+
+/// Tolerance of the PKW and record cases: the answer may come one cycle late.
+const EXCHANGE: Tolerance = Tolerance {
+    cycles: 1,
+    position: 0,
+    speed: 0,
+};
+
+/// A generated case.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PsdCase {
+    /// The steps.
+    pub steps: Vec<StepDef>,
+    /// Tolerances.
+    pub tol: Tolerance,
+    /// Whether the report gets a position/speed/status plot.
+    pub plot: bool,
+}
+
+struct Gen<'a> {
+    family: &'a Family,
+    model: &'a DeviceModel,
+    pkw: &'a PkwRules,
+    drive_rules: &'a Rules,
+    errors: Vec<String>,
+    out: Vec<(CaseInfo, PsdCase)>,
+}
+
+/// Control-word values by their spec name (bitfield `control`, 4.1).
+fn control(family: &Family, name: &str) -> Result<u16, String> {
+    family
+        .bitfield("control")
+        .and_then(|b| b.values.iter().find(|v| v.name == name))
+        .and_then(|v| u16::try_from(v.value).ok())
+        .ok_or_else(|| format!("no control-word value {name:?} in bitfield control"))
+}
+
+/// The control bit named `name` as a mask (bitfield `control`, 3.7).
+fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
+    family
+        .bitfield("control")
+        .and_then(|b| b.bits.iter().find(|x| x.name == name))
+        .and_then(|x| 1u16.checked_shl(x.bit))
+        .ok_or_else(|| format!("no control bit {name:?}"))
+}
+
+fn step(role: Role, text: impl Into<String>, action: Action) -> StepDef {
+    StepDef {
+        role,
+        text: text.into(),
+        action,
+    }
+}
+
+impl Gen<'_> {
+    fn push(&mut self, id: String, reqs: &[&str], description: String, case: PsdCase) {
+        let mut requirements: Vec<String> = Vec::new();
+        let mut level = Level::Informative;
+        for r in reqs {
+            match self.family.requirement(r) {
+                Some(q) => {
+                    level = level.min(q.level);
+                    requirements.push(q.id.clone());
+                }
+                None => self.errors.push(format!("{id}: unknown requirement {r}")),
+            }
+        }
+        requirements.sort();
+        requirements.dedup();
+        let steps = case.steps.iter().map(|s| s.text.clone()).collect();
+        self.out.push((
+            CaseInfo {
+                id,
+                family: FamilyId::Psd4xx,
+                requirements,
+                level,
+                description,
+                steps,
+            },
+            case,
+        ));
+    }
+
+    fn request(&mut self, r: Request) -> PkwRequest {
+        match self.pkw.encode_request(&r) {
+            Ok(p) => p,
+            Err(e) => {
+                self.errors.push(format!("cannot encode {r:?}: {e}"));
+                PkwRequest::default()
+            }
+        }
+    }
+
+    fn none(&mut self) -> PkwRequest {
+        self.request(Request::None)
+    }
+
+    /// A PKW command, the response held for 3 cycles, then "no command".
+    fn exchange(&mut self, steps: &mut Vec<StepDef>, role: Role, text: &str, r: Request) {
+        let req = self.request(r);
+        let none = self.none();
+        steps.push(step(role, text, Action::Pkw(req)));
+        steps.push(step(
+            role,
+            "command repeated: the response is held",
+            Action::Hold(3),
+        ));
+        steps.push(step(role, "no command: no response", Action::Pkw(none)));
+        steps.push(step(role, "no response held", Action::Hold(2)));
+    }
+
+    fn range(&self, p: &Parameter) -> Option<(i64, i64)> {
+        let r = self.family.resolve(p, Some(self.model)).range?;
+        Some((r.min()?, r.max()?))
+    }
+
+    fn width(p: &Parameter) -> Option<Width> {
+        Width::of_type(p.data_type)
+    }
+
+    fn pkw_cases(&mut self) {
+        let params: Vec<&Parameter> = self.family.parameters.iter().collect();
+        for p in params {
+            let Ok(pnu) = u16::try_from(p.number) else {
+                continue;
+            };
+            let num = p.number;
+            if let Some(n) = p.array {
+                // Par. 13: segments, one past the end, count.
+                for i in 0..=n {
+                    let Ok(index) = u16::try_from(i) else {
+                        continue;
+                    };
+                    let mut steps = Vec::new();
+                    let text = format!("read par {num} element {i}");
+                    self.exchange(
+                        &mut steps,
+                        Role::Check,
+                        &text,
+                        Request::Read {
+                            pnu,
+                            index: Some(index),
+                        },
+                    );
+                    let (id, reqs): (String, &[&str]) = if i < n {
+                        (
+                            format!("psd4xx/pkw/array/{num}/element-{i}"),
+                            &[
+                                "PSD-PKW-015",
+                                "PSD-PKW-020",
+                                "PSD-PKW-035",
+                                "PSD-PKW-036",
+                                "PSD-PKW-037",
+                            ],
+                        )
+                    } else {
+                        (
+                            format!("psd4xx/pkw/array/{num}/bad-subindex"),
+                            &["PSD-PKW-026", "PSD-PKW-019", "PSD-PKW-022"],
+                        )
+                    };
+                    self.push(
+                        id,
+                        reqs,
+                        text,
+                        PsdCase {
+                            steps,
+                            tol: EXCHANGE,
+                            plot: false,
+                        },
+                    );
+                }
+                let mut steps = Vec::new();
+                self.exchange(
+                    &mut steps,
+                    Role::Check,
+                    "number of elements",
+                    Request::Count { pnu },
+                );
+                self.push(
+                    format!("psd4xx/pkw/array/{num}/count"),
+                    &["PSD-PKW-018"],
+                    format!("command 9 on par {num}: number of elements"),
+                    PsdCase {
+                        steps,
+                        tol: EXCHANGE,
+                        plot: false,
+                    },
+                );
+                continue;
+            }
+            // Read.
+            let mut steps = Vec::new();
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("read par {num}"),
+                Request::Read { pnu, index: None },
+            );
+            let mut reqs = vec!["PSD-PKW-001", "PSD-PKW-011", "PSD-PKW-012", "PSD-PKW-006"];
+            if Self::width(p) == Some(Width::Word) {
+                reqs.push("PSD-PKW-038");
+            }
+            self.push(
+                format!("psd4xx/pkw/read/{num}"),
+                &reqs,
+                format!("read par {num} ({}) through PKW", p.name),
+                PsdCase {
+                    steps,
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+            let Some(width) = Self::width(p) else {
+                continue;
+            };
+            if !p.access.writable() {
+                let mut steps = Vec::new();
+                self.exchange(
+                    &mut steps,
+                    Role::Check,
+                    &format!("write par {num}"),
+                    Request::Write {
+                        pnu,
+                        index: None,
+                        width,
+                        value: 0,
+                    },
+                );
+                let reqs: &[&str] = if p.access == Access::Pd {
+                    &["PSD-PKW-024", "PSD-PD-009"]
+                } else {
+                    &["PSD-PKW-024", "PSD-PAR-READONLY-001"]
+                };
+                self.push(
+                    format!("psd4xx/pkw/write/{num}/read-only"),
+                    reqs,
+                    format!("write to par {num} ({}): error 1", p.name),
+                    PsdCase {
+                        steps,
+                        tol: EXCHANGE,
+                        plot: false,
+                    },
+                );
+                continue;
+            }
+            if num == 96 {
+                continue; // the par96 group
+            }
+            let Some((min, max)) = self.range(p) else {
+                continue;
+            };
+            let (tlo, thi) = p.data_type.bounds().unwrap_or((i64::MIN, i64::MAX));
+            let mut edges = vec![("min", min, true), ("max", max, true)];
+            if min > tlo {
+                edges.push(("below-min", min - 1, false));
+            }
+            if max < thi {
+                edges.push(("above-max", max + 1, false));
+            }
+            for (name, value, ok) in edges {
+                let mut steps = Vec::new();
+                self.exchange(
+                    &mut steps,
+                    Role::Check,
+                    &format!("write par {num} = {value}"),
+                    Request::Write {
+                        pnu,
+                        index: None,
+                        width,
+                        value,
+                    },
+                );
+                self.exchange(
+                    &mut steps,
+                    Role::Check,
+                    &format!("read par {num} back"),
+                    Request::Read { pnu, index: None },
+                );
+                let reqs: &[&str] = match (ok, width) {
+                    (true, Width::Word) => {
+                        &["PSD-PKW-013", "PSD-PKW-032", "PSD-PKW-033", "PSD-PKW-034"]
+                    }
+                    (true, Width::Dword) => {
+                        &["PSD-PKW-014", "PSD-PKW-032", "PSD-PKW-033", "PSD-PKW-034"]
+                    }
+                    (false, _) => &[
+                        "PSD-PKW-025",
+                        "PSD-PAR-RANGE-001",
+                        "PSD-PKW-019",
+                        "PSD-PKW-022",
+                    ],
+                };
+                self.push(
+                    format!("psd4xx/pkw/write/{num}/{name}"),
+                    reqs,
+                    format!(
+                        "write {value} to par {num} ({}) on {}",
+                        p.name, self.model.id
+                    ),
+                    PsdCase {
+                        steps,
+                        tol: EXCHANGE,
+                        plot: false,
+                    },
+                );
+            }
+            // Wrong data type (PSD-PKW-028).
+            let other = match width {
+                Width::Word => Width::Dword,
+                Width::Dword => Width::Word,
+            };
+            let mut steps = Vec::new();
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("write par {num} with the other width"),
+                Request::Write {
+                    pnu,
+                    index: None,
+                    width: other,
+                    value: 0,
+                },
+            );
+            self.push(
+                format!("psd4xx/pkw/error/wrong-type/{num}"),
+                &["PSD-PKW-028", "PSD-PKW-019"],
+                format!(
+                    "a {} write command to par {num}: error 5",
+                    if other == Width::Word {
+                        "word"
+                    } else {
+                        "double-word"
+                    }
+                ),
+                PsdCase {
+                    steps,
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+        }
+        // Unknown parameter numbers.
+        let max = self.pkw.pnu_max();
+        for pnu in [0u16, 15, 99, max] {
+            if self
+                .family
+                .parameters
+                .iter()
+                .any(|p| p.number == u32::from(pnu))
+            {
+                continue;
+            }
+            let mut steps = Vec::new();
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("read par {pnu}"),
+                Request::Read { pnu, index: None },
+            );
+            self.push(
+                format!("psd4xx/pkw/unknown/{pnu}"),
+                &["PSD-PKW-023", "PSD-PKW-019", "PSD-PKW-022"],
+                format!("read of the unknown par {pnu}: error 0"),
+                PsdCase {
+                    steps,
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+        }
+    }
+
+    fn pkw_rules_cases(&mut self) -> Result<(), String> {
+        let none = self.none();
+        // No command only.
+        self.push(
+            "psd4xx/pkw/no-command".to_owned(),
+            &["PSD-PKW-006", "PSD-PKW-010"],
+            "command 0 is answered with response 0".to_owned(),
+            PsdCase {
+                steps: vec![
+                    step(Role::Check, "no command", Action::Pkw(none)),
+                    step(Role::Check, "hold", Action::Hold(3)),
+                ],
+                tol: EXCHANGE,
+                plot: false,
+            },
+        );
+        // The response holds the value of the moment of the command (par 3 while running).
+        let rt = control(self.family, "release-and-transfer")?;
+        let read3 = self.request(Request::Read {
+            pnu: 3,
+            index: None,
+        });
+        self.push(
+            "psd4xx/pkw/held-while-running".to_owned(),
+            &["PSD-PKW-003", "PSD-PKW-004", "PSD-PKW-007"],
+            "a read of the actual position during a run keeps its value while the command is repeated".to_owned(),
+            PsdCase {
+                steps: vec![
+                    step(Role::Setup, "0x14 to 400000", Action::Process { control: Some(rt), target: Some(400_000) }),
+                    step(Role::Setup, "until running", Action::Until { running: true, max: 200 }),
+                    step(Role::Setup, "run a while", Action::Hold(20)),
+                    step(Role::Check, "read par 3", Action::Pkw(read3)),
+                    step(Role::Check, "repeat: value held", Action::Hold(20)),
+                    step(Role::Check, "no command", Action::Pkw(none)),
+                    step(Role::Check, "read par 3 again: a new value", Action::Pkw(read3)),
+                    step(Role::Check, "repeat", Action::Hold(5)),
+                ],
+                tol: EXCHANGE,
+                plot: false,
+            },
+        );
+        // Re-reading needs command 0 in between (a record changes the value meanwhile).
+        let read44 = self.request(Request::Read {
+            pnu: 44,
+            index: None,
+        });
+        let w44 = self.record_write(44, 1, 7)?;
+        self.push(
+            "psd4xx/pkw/reread-after-no-command".to_owned(),
+            &["PSD-PKW-005", "PSD-PKW-003"],
+            "repeating a read without command 0 keeps the old answer; after command 0 the new value comes".to_owned(),
+            PsdCase {
+                steps: vec![
+                    step(Role::Check, "read par 44", Action::Pkw(read44)),
+                    step(Role::Setup, "record write par 44 = 7", Action::Record(w44)),
+                    step(Role::Check, "repeat the read: old answer held", Action::Hold(4)),
+                    step(Role::Check, "no command", Action::Pkw(none)),
+                    step(Role::Check, "read par 44: 7", Action::Pkw(read44)),
+                ],
+                tol: EXCHANGE,
+                plot: false,
+            },
+        );
+        // Array command on a scalar.
+        let arr = self.request(Request::Read {
+            pnu: 44,
+            index: Some(0),
+        });
+        self.push(
+            "psd4xx/pkw/error/no-array".to_owned(),
+            &["PSD-PKW-027", "PSD-PKW-019"],
+            "an array read of the scalar par 44: error 4".to_owned(),
+            PsdCase {
+                steps: vec![
+                    step(Role::Check, "array read of par 44", Action::Pkw(arr)),
+                    step(Role::Check, "hold", Action::Hold(2)),
+                    step(Role::Check, "no command", Action::Pkw(none)),
+                ],
+                tol: EXCHANGE,
+                plot: false,
+            },
+        );
+        // An undefined command code.
+        let undefined = (0..=self.pkw.ak_max())
+            .map(drivespec_psd4xx::CommandCode::from)
+            .find(|c| self.pkw.command_info(*c).is_none());
+        if let Some(ak) = undefined {
+            let req = PkwRequest {
+                ak,
+                spm: false,
+                pnu: 44,
+                ind: 0,
+                pwe: 0,
+            };
+            self.push(
+                "psd4xx/pkw/error/undefined-command".to_owned(),
+                &["PSD-PKW-031", "PSD-PKW-019"],
+                format!("command code {} (not in the table): error 18", u8::from(ak)),
+                PsdCase {
+                    steps: vec![
+                        step(Role::Check, "undefined command on par 44", Action::Pkw(req)),
+                        step(Role::Check, "hold", Action::Hold(2)),
+                        step(Role::Check, "no command", Action::Pkw(none)),
+                    ],
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+        }
+        // A standstill-only write while running (par 45, the loop length).
+        if let Some(p45) = self.family.parameter("45") {
+            if let Some(w) = Self::width(p45) {
+                let value = self
+                    .family
+                    .resolve(p45, Some(self.model))
+                    .default
+                    .unwrap_or(0);
+                let req = self.request(Request::Write {
+                    pnu: 45,
+                    index: None,
+                    width: w,
+                    value,
+                });
+                self.push(
+                    "psd4xx/pkw/error/operating-state".to_owned(),
+                    &["PSD-PKW-030", "PSD-PKW-019"],
+                    "writing par 45 during a run: error 17".to_owned(),
+                    PsdCase {
+                        steps: vec![
+                            step(
+                                Role::Setup,
+                                "0x14 to 400000",
+                                Action::Process {
+                                    control: Some(rt),
+                                    target: Some(400_000),
+                                },
+                            ),
+                            step(
+                                Role::Setup,
+                                "until running",
+                                Action::Until {
+                                    running: true,
+                                    max: 200,
+                                },
+                            ),
+                            step(Role::Check, "write par 45", Action::Pkw(req)),
+                            step(Role::Check, "hold", Action::Hold(2)),
+                            step(Role::Check, "no command", Action::Pkw(none)),
+                        ],
+                        tol: EXCHANGE,
+                        plot: false,
+                    },
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn record_write(&self, index: u16, control: u8, value: i64) -> Result<RecordRequest, String> {
+        let p = self
+            .family
+            .parameters
+            .iter()
+            .find(|p| p.number == u32::from(index))
+            .ok_or_else(|| format!("no par {index}"))?;
+        let width = Self::width(p).ok_or_else(|| format!("par {index} has no width"))?;
+        let rules = self.drive_rules.record();
+        let data = RecordWrite {
+            index,
+            control,
+            width,
+            value,
+        }
+        .to_bytes(rules)
+        .map_err(|e| format!("record write {index}: {e}"))?;
+        Ok(RecordRequest::Write { index, data })
+    }
+}
+
+/// Bits of the status word by their spec name (bitfield `status`, 3.6).
+pub(crate) fn status_bit(family: &Family, name: &str) -> Result<u16, String> {
+    family
+        .bitfield("status")
+        .and_then(|b| b.bits.iter().find(|x| x.name == name))
+        .and_then(|x| 1u16.checked_shl(x.bit))
+        .ok_or_else(|| format!("no status bit {name:?}"))
+}
+
+impl Gen<'_> {
+    fn record_cases(&mut self) -> Result<(), String> {
+        let params: Vec<&Parameter> = self.family.parameters.iter().collect();
+        let execute = self.drive_rules.record().control_ignore().wrapping_add(1);
+        let ignore = self.drive_rules.record().control_ignore();
+        for p in params {
+            let Ok(index) = u16::try_from(p.number) else {
+                continue;
+            };
+            let num = p.number;
+            let width = Self::width(p);
+            let read_reqs: &[&str] = match (p.array.is_some(), width) {
+                (true, _) => &["PSD-REC-001", "PSD-REC-002", "PSD-REC-010"],
+                (false, Some(Width::Word)) => &["PSD-REC-001", "PSD-REC-002", "PSD-REC-008"],
+                _ => &["PSD-REC-001", "PSD-REC-002", "PSD-REC-009"],
+            };
+            self.push(
+                format!("psd4xx/record/read/{num}"),
+                read_reqs,
+                format!("read record {num} ({})", p.name),
+                PsdCase {
+                    steps: vec![step(
+                        Role::Check,
+                        format!("read record {num}"),
+                        Action::Record(RecordRequest::Read { index }),
+                    )],
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+            let Some(width) = width else { continue };
+            if p.array.is_some() || num == 96 {
+                continue;
+            }
+            if !p.access.writable() {
+                let w = self.record_write(index, execute, 0)?;
+                self.push(
+                    format!("psd4xx/record/write/{num}/read-only"),
+                    &["PSD-REC-001", "PSD-PAR-READONLY-001"],
+                    format!("record write to the read-only par {num}: refused"),
+                    PsdCase {
+                        steps: vec![step(
+                            Role::Check,
+                            format!("write record {num}"),
+                            Action::Record(w),
+                        )],
+                        tol: EXCHANGE,
+                        plot: false,
+                    },
+                );
+                continue;
+            }
+            let Some((min, max)) = self.range(p) else {
+                continue;
+            };
+            let size: &str = if width == Width::Word {
+                "PSD-REC-006"
+            } else {
+                "PSD-REC-007"
+            };
+            let read = Action::Record(RecordRequest::Read { index });
+            let w = self.record_write(index, execute, min)?;
+            self.push(
+                format!("psd4xx/record/write/{num}/execute"),
+                &["PSD-REC-003", "PSD-REC-005", size],
+                format!("record write par {num} = {min} with control byte {execute}, read back"),
+                PsdCase {
+                    steps: vec![
+                        step(
+                            Role::Check,
+                            format!("write record {num} = {min}"),
+                            Action::Record(w),
+                        ),
+                        step(Role::Check, format!("read record {num}"), read.clone()),
+                    ],
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+            let w = self.record_write(index, ignore, max)?;
+            self.push(
+                format!("psd4xx/record/write/{num}/control-0"),
+                &["PSD-REC-004", "PSD-REC-003", size],
+                format!("record write par {num} = {max} with control byte {ignore}: ignored"),
+                PsdCase {
+                    steps: vec![
+                        step(
+                            Role::Check,
+                            format!("write record {num} = {max}, control {ignore}"),
+                            Action::Record(w),
+                        ),
+                        step(
+                            Role::Check,
+                            format!("read record {num}: unchanged"),
+                            read.clone(),
+                        ),
+                    ],
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+            if let RecordRequest::Write { data, .. } = self.record_write(index, execute, min)? {
+                let short = data
+                    .get(..data.len().saturating_sub(1))
+                    .unwrap_or(&[])
+                    .to_vec();
+                self.push(
+                    format!("psd4xx/record/write/{num}/short"),
+                    &[size],
+                    format!("record write par {num} one byte short: malformed"),
+                    PsdCase {
+                        steps: vec![
+                            step(
+                                Role::Check,
+                                format!("write record {num}, {} bytes", short.len()),
+                                Action::Record(RecordRequest::Write { index, data: short }),
+                            ),
+                            step(Role::Check, format!("read record {num}: unchanged"), read),
+                        ],
+                        tol: EXCHANGE,
+                        plot: false,
+                    },
+                );
+            }
+        }
+        for index in [0u16, 99] {
+            self.push(
+                format!("psd4xx/record/unknown/{index}"),
+                &["PSD-REC-002"],
+                format!("read record {index} (no such parameter): refused"),
+                PsdCase {
+                    steps: vec![step(
+                        Role::Check,
+                        format!("read record {index}"),
+                        Action::Record(RecordRequest::Read { index }),
+                    )],
+                    tol: EXCHANGE,
+                    plot: false,
+                },
+            );
+        }
+        Ok(())
+    }
+
+    fn write_pkw(&mut self, steps: &mut Vec<StepDef>, pnu: u16, value: i64) {
+        let width = self
+            .family
+            .parameters
+            .iter()
+            .find(|p| p.number == u32::from(pnu))
+            .and_then(Self::width)
+            .unwrap_or(Width::Word);
+        let req = self.request(Request::Write {
+            pnu,
+            index: None,
+            width,
+            value,
+        });
+        let none = self.none();
+        steps.push(step(
+            Role::Setup,
+            format!("write par {pnu} = {value}"),
+            Action::Pkw(req),
+        ));
+        steps.push(step(Role::Setup, "no command", Action::Pkw(none)));
+    }
+
+    fn sequence_cases(&mut self) {
+        let vectors: Vec<_> = self
+            .family
+            .vectors
+            .iter()
+            .filter(|v| v.kind == VectorKind::Sequence)
+            .collect();
+        let window_default = self
+            .family
+            .parameter("44")
+            .and_then(|p| self.family.resolve(p, Some(self.model)).default)
+            .unwrap_or(2);
+        'vectors: for v in vectors {
+            if v.model
+                .as_deref()
+                .is_some_and(|m| self.family.model(m).map(|x| &x.id) != Some(&self.model.id))
+            {
+                continue;
+            }
+            let mut steps = Vec::new();
+            let mut window = window_default;
+            if let Some(state) = v.input("state").and_then(toml::Value::as_table) {
+                let mut keys: Vec<(&String, &toml::Value)> = state.iter().collect();
+                keys.sort_by_key(|(k, _)| (k.as_str() != "41", k.parse::<u32>().unwrap_or(0)));
+                for (k, value) in keys {
+                    let (Ok(pnu), Some(value)) = (k.parse::<u16>(), value.as_integer()) else {
+                        continue 'vectors; // strings (par 13) and live values need recipes
+                    };
+                    if pnu == 1 || pnu == 2 {
+                        continue 'vectors;
+                    }
+                    if pnu == 44 {
+                        window = value;
+                    }
+                    if pnu == 3 && value == 0 {
+                        continue;
+                    }
+                    self.write_pkw(&mut steps, pnu, value);
+                }
+            }
+            let Some(list) = v.input("steps").and_then(toml::Value::as_array) else {
+                continue;
+            };
+            for (n, s) in list.iter().enumerate() {
+                let Some(s) = s.as_table() else {
+                    continue 'vectors;
+                };
+                let int = |k: &str| s.get(k).and_then(toml::Value::as_integer);
+                let mut jam = false;
+                if let Some(e) = s.get("event").and_then(toml::Value::as_str) {
+                    let env = match e {
+                        "power-on" => Env::PowerCycle,
+                        "obstruction-detected" => {
+                            jam = true;
+                            Env::Jam(true)
+                        }
+                        "manual-rotation-at-standstill" => {
+                            let d = int("distance").unwrap_or(0);
+                            Env::Displace(match s.get("direction").and_then(toml::Value::as_str) {
+                                Some("decreasing") => -d,
+                                _ => d,
+                            })
+                        }
+                        "motor-voltage-out-of-range" => Env::MotorVoltage(100),
+                        "motor-voltage-in-range" => Env::MotorVoltage(240),
+                        "position-outside-window-after-run" => Env::MissSteps(window + 1),
+                        "connection-interrupted" => Env::Link(LinkEvent::Lost),
+                        "connection-restored" => Env::Link(LinkEvent::Connected),
+                        "iops-bad" => Env::Link(LinkEvent::IopsBad),
+                        other => {
+                            self.errors.push(format!("{}: unknown event {other}", v.id));
+                            continue 'vectors;
+                        }
+                    };
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: {e}"),
+                        Action::Env(env),
+                    ));
+                }
+                let control = int("control").and_then(|c| u16::try_from(c).ok());
+                let target = int("target").and_then(|t| i32::try_from(t).ok());
+                if let Some(o) = int("target_offset") {
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: target = actual {o:+}"),
+                        Action::Offset { control, offset: o },
+                    ));
+                } else {
+                    let text = match (control, target) {
+                        (Some(c), Some(t)) => format!("step {n}: control {c:#06x}, target {t}"),
+                        (Some(c), None) => format!("step {n}: control {c:#06x}"),
+                        (None, Some(t)) => format!("step {n}: target {t}"),
+                        (None, None) => format!("step {n}: one cycle"),
+                    };
+                    steps.push(step(Role::Check, text, Action::Process { control, target }));
+                }
+                let wait = match s.get("wait").and_then(toml::Value::as_str) {
+                    Some("running") => Action::Until {
+                        running: true,
+                        max: 1_000,
+                    },
+                    Some("standstill") => Action::Until {
+                        running: false,
+                        max: 12_000,
+                    },
+                    _ => Action::Hold(50),
+                };
+                let wtext = s
+                    .get("wait")
+                    .and_then(toml::Value::as_str)
+                    .unwrap_or("settle");
+                steps.push(step(Role::Check, format!("step {n}: wait {wtext}"), wait));
+                if jam {
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: obstruction removed"),
+                        Action::Env(Env::Jam(false)),
+                    ));
+                }
+            }
+            steps.push(step(Role::Check, "settle", Action::Hold(10)));
+            let reqs: Vec<&str> = v.requirements.iter().map(String::as_str).collect();
+            self.push(
+                format!("psd4xx/sequence/{}", v.id),
+                &reqs,
+                v.description.clone(),
+                PsdCase {
+                    steps,
+                    tol: MOTION,
+                    plot: true,
+                },
+            );
+        }
+    }
+
+    fn motion(&mut self, id: &str, reqs: &[&str], description: &str, steps: Vec<StepDef>) {
+        let mut steps = steps;
+        steps.push(step(Role::Check, "settle", Action::Hold(10)));
+        self.push(
+            id.to_owned(),
+            reqs,
+            description.to_owned(),
+            PsdCase {
+                steps,
+                tol: MOTION,
+                plot: true,
+            },
+        );
+    }
+
+    fn position_cases(&mut self) -> Result<(), String> {
+        let f = self.family;
+        let rt = control(f, "release-and-transfer")?;
+        let direct = control(f, "release-and-transfer-without-loop")?;
+        let up = control(f, "manual-run-larger")?;
+        let down = control(f, "manual-run-smaller")?;
+        let release = control(f, "release")?;
+        let stop = control(f, "stop")?;
+        let toggle = control_bit(f, "Toggle bit")?;
+        let run = |c: u16, t: i32| {
+            step(
+                Role::Check,
+                format!("control {c:#06x}, target {t}"),
+                Action::Process {
+                    control: Some(c),
+                    target: Some(t),
+                },
+            )
+        };
+        let ctl = |c: u16| {
+            step(
+                Role::Check,
+                format!("control {c:#06x}"),
+                Action::Process {
+                    control: Some(c),
+                    target: None,
+                },
+            )
+        };
+        let running = || {
+            step(
+                Role::Check,
+                "until running",
+                Action::Until {
+                    running: true,
+                    max: 1_000,
+                },
+            )
+        };
+        let still = || {
+            step(
+                Role::Check,
+                "until standstill",
+                Action::Until {
+                    running: false,
+                    max: 12_000,
+                },
+            )
+        };
+        let hold = |n: u32| step(Role::Check, format!("{n} cycles"), Action::Hold(n));
+        self.motion(
+            "psd4xx/position/loop/up",
+            &[
+                "PSD-POS-001",
+                "PSD-POS-007",
+                "PSD-POS-010",
+                "PSD-STS-0-SET-1",
+            ],
+            "0x14 to a larger target: direct approach in loop direction",
+            vec![run(rt, 4000), running(), still()],
+        );
+        self.motion(
+            "psd4xx/position/loop/down",
+            &["PSD-POS-001", "PSD-POS-007", "PSD-POS-011", "PSD-POS-012"],
+            "0x14 to a smaller target: overrun by the loop, approach in loop direction",
+            vec![run(rt, -4000), running(), still()],
+        );
+        self.motion(
+            "psd4xx/position/no-loop/up",
+            &["PSD-POS-017"],
+            "0x54 to a larger target: direct",
+            vec![run(direct, 4000), running(), still()],
+        );
+        self.motion(
+            "psd4xx/position/no-loop/down",
+            &["PSD-POS-017", "PSD-POS-012"],
+            "0x54 to a smaller target: direct, no loop",
+            vec![run(direct, -4000), running(), still()],
+        );
+        self.motion(
+            "psd4xx/position/manual/up",
+            &["PSD-RUN-004", "PSD-RUN-005", "PSD-STS-0-SET-2"],
+            "0x11 manual run up, then 0x10 stops",
+            vec![ctl(up), running(), hold(50), ctl(release), still()],
+        );
+        self.motion(
+            "psd4xx/position/manual/down",
+            &["PSD-RUN-004", "PSD-RUN-006"],
+            "0x12 manual run down, then 0x00 stops",
+            vec![ctl(down), running(), hold(50), ctl(stop), still()],
+        );
+        self.motion(
+            "psd4xx/position/release-withdrawn",
+            &["PSD-RUN-001", "PSD-CTL-4-003", "PSD-STS-5-SET-1"],
+            "0x00 during a run aborts it and sets bit 5",
+            vec![run(rt, 400_000), running(), hold(20), ctl(stop), still()],
+        );
+        self.motion(
+            "psd4xx/position/new-target/same-direction",
+            &["PSD-POS-002", "PSD-POS-003"],
+            "a new target during a run is approached without a stop",
+            vec![
+                run(rt, 40_000),
+                running(),
+                hold(10),
+                run(rt, 80_000),
+                still(),
+            ],
+        );
+        self.motion(
+            "psd4xx/position/new-target/reverse",
+            &["PSD-POS-002"],
+            "a new target behind the drive during a run",
+            vec![
+                run(rt, 400_000),
+                running(),
+                hold(30),
+                run(rt, -4000),
+                still(),
+            ],
+        );
+        // Status.
+        self.motion(
+            "psd4xx/status/power-on",
+            &["PSD-STS-8-SET-1"],
+            "status word after switching on",
+            vec![
+                step(Role::Check, "power cycle", Action::Env(Env::PowerCycle)),
+                hold(10),
+            ],
+        );
+        self.motion(
+            "psd4xx/status/toggle",
+            &["PSD-CTL-13-001"],
+            "control bit 13 is copied into the status word every cycle",
+            vec![
+                ctl(toggle),
+                hold(2),
+                ctl(0),
+                hold(2),
+                ctl(toggle),
+                ctl(0),
+                ctl(toggle | rt),
+                running(),
+                ctl(rt),
+                hold(3),
+                ctl(toggle | rt),
+            ],
+        );
+        self.motion(
+            "psd4xx/status/obstruction",
+            &["PSD-STS-10-SET-1", "PSD-OBST-001"],
+            "an obstruction during a run stops it with bit 10",
+            vec![
+                run(rt, 40_000),
+                running(),
+                step(Role::Check, "obstruction", Action::Env(Env::Jam(true))),
+                still(),
+                hold(20),
+                step(
+                    Role::Check,
+                    "obstruction removed",
+                    Action::Env(Env::Jam(false)),
+                ),
+                hold(10),
+            ],
+        );
+        self.motion(
+            "psd4xx/status/incorrect-target",
+            &["PSD-STS-12-SET-1"],
+            "a target beyond the end limits sets bit 12 and does not run",
+            vec![run(rt, i32::MAX), hold(20)],
+        );
+        Ok(())
+    }
+
+    fn par96_cases(&mut self) -> Result<(), String> {
+        let Some(p44) = self.family.parameter("44") else {
+            return Err("no par 44".to_owned());
+        };
+        let (min, max) = self.range(p44).ok_or("par 44 has no range")?;
+        let default = self
+            .family
+            .resolve(p44, Some(self.model))
+            .default
+            .unwrap_or(min);
+        // Two values apart from the delivery value: one saved, one only in the working set.
+        let (saved, working) = if default.saturating_add(2) <= max {
+            (default + 1, default + 2)
+        } else if default.saturating_sub(2) >= min {
+            (default - 1, default - 2)
+        } else {
+            return Err("par 44 has no room for two changed values".to_owned());
+        };
+        let read44 = Request::Read {
+            pnu: 44,
+            index: None,
+        };
+        for (v, reqs) in [
+            (-6i64, &["PSD-PAR-96-001"][..]),
+            (-5, &["PSD-PAR-96-002"][..]),
+            (-4, &["PSD-PAR-96-003"][..]),
+            (-3, &["PSD-PAR-96-004"][..]),
+            (-2, &["PSD-PAR-96-005"][..]),
+            (-1, &["PSD-PAR-96-006"][..]),
+            (1, &["PSD-PAR-96-007", "PSD-PAR-96-009"][..]),
+            (0, &["PSD-PAR-96-008"][..]),
+            (2, &["PSD-PAR-96-008"][..]),
+            (-7, &["PSD-PAR-96-008"][..]),
+        ] {
+            let mut steps = Vec::new();
+            self.write_pkw(&mut steps, 44, saved);
+            self.write_pkw(&mut steps, 96, 1);
+            self.write_pkw(&mut steps, 44, working);
+            let req = Request::Write {
+                pnu: 96,
+                index: None,
+                width: Width::Word,
+                value: v,
+            };
+            self.exchange(&mut steps, Role::Check, &format!("write par 96 = {v}"), req);
+            steps.push(step(
+                Role::Check,
+                "until standstill",
+                Action::Until {
+                    running: false,
+                    max: 12_000,
+                },
+            ));
+            self.exchange(&mut steps, Role::Check, "read par 44", read44);
+            steps.push(step(
+                Role::Check,
+                "power cycle",
+                Action::Env(Env::PowerCycle),
+            ));
+            steps.push(step(Role::Check, "settle", Action::Hold(5)));
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                "read par 44 after power-up",
+                read44,
+            );
+            let name = if v < 0 {
+                format!("minus-{}", -v)
+            } else {
+                v.to_string()
+            };
+            self.push(
+                format!("psd4xx/par96/{name}"),
+                reqs,
+                format!("par 44 saved and changed again, par 96 = {v}, read back, power cycle, read back"),
+                PsdCase { steps, tol: MOTION, plot: false },
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Every case of the suite for `model`, in run order.
+pub(crate) fn generate(
+    family: &Family,
+    model: &DeviceModel,
+    drive: &Drive,
+) -> Result<(Vec<CaseInfo>, Vec<PsdCase>), String> {
+    let rules = drive.rules();
+    let mut g = Gen {
+        family,
+        model,
+        pkw: rules.pkw(),
+        drive_rules: rules,
+        errors: Vec::new(),
+        out: Vec::new(),
+    };
+    g.pkw_cases();
+    g.pkw_rules_cases()?;
+    g.record_cases()?;
+    g.sequence_cases();
+    g.position_cases()?;
+    g.par96_cases()?;
+    if let Some(first) = g.errors.first() {
+        return Err(format!(
+            "{} problem(s) generating PSD4xx cases, first: {first}; all: {}",
+            g.errors.len(),
+            g.errors.join("; ")
+        ));
+    }
+    Ok(g.out.into_iter().unzip())
+}

@@ -1,0 +1,96 @@
+//! The fuzzer against every HPD mutant of the conformance tests (`support::mutants`): for a
+//! fixed seed it finds the planted bug within a bounded number of sequences, and the
+//! minimised replay is short (at most 5 exchanges for bugs one message shows; the PLC
+//! arithmetic bugs need a program uploaded and run). Prints iterations and replay lengths.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+mod support;
+
+use drivespec_conform::fuzz::{self, FindingClass, Options};
+use drivespec_conform::link::SimLink;
+use drivespec_conform::Progress;
+use support::mutants::{mutants, spec, Kind, Mutant};
+
+/// Sequences each mutant gets.
+const BOUND: u64 = 80;
+
+#[test]
+fn every_mutant_is_found_with_a_short_replay() {
+    let opts = Options {
+        iterations: Some(BOUND),
+        minimize_runs: 100,
+        no_reports: true,
+        progress: Progress::Quiet,
+        ..Options::default()
+    };
+    let all = mutants();
+    let results: Vec<(String, Kind, fuzz::Summary)> = std::thread::scope(|s| {
+        let handles: Vec<_> = all
+            .iter()
+            .map(|m| {
+                let opts = &opts;
+                s.spawn(move || {
+                    let link =
+                        SimLink::new(format!("mutant: {}", m.name), Box::new(Mutant::new(m.kind)));
+                    let summary =
+                        fuzz::run_on(spec(), opts, Box::new(link), &mut std::io::sink()).unwrap();
+                    (m.name.to_owned(), m.kind, summary)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let mut problems = Vec::new();
+    for (name, kind, s) in &results {
+        let first = s.stats.findings.iter().map(|f| f.first_sequence).min();
+        let shortest = s
+            .stats
+            .findings
+            .iter()
+            .filter(|f| f.reproduced)
+            .map(|f| f.exchanges)
+            .min();
+        println!(
+            "{name:<34} found after {:>3} sequence(s); shortest replay {} exchange(s); {} finding(s): {}",
+            first.map_or("-".to_owned(), |n| n.to_string()),
+            shortest.map_or("-".to_owned(), |n| n.to_string()),
+            s.findings.len(),
+            s.stats.findings.iter().map(|f| f.signature.as_str()).collect::<Vec<_>>().join(", ")
+        );
+        let limit = match kind {
+            // A PLC program uploaded, operands set, run and read back.
+            Kind::Reading("div-remainder", _) | Kind::Reading("b99-3", _) => 10,
+            _ => 5,
+        };
+        match shortest {
+            None => problems.push(format!("{name}: not found in {BOUND} sequences")),
+            Some(n) if n > limit => {
+                problems.push(format!("{name}: shortest replay {n} exchanges > {limit}"))
+            }
+            Some(_) => {}
+        }
+        if s.exit_code() != 1 {
+            problems.push(format!("{name}: exit code {}", s.exit_code()));
+        }
+        // Every finding replays: the same bytes and the same verdict again.
+        for f in &s.findings {
+            let link = SimLink::new("mutant", Box::new(Mutant::new(*kind)));
+            let again = fuzz::replay_on(spec(), &opts, &f.replay, Box::new(link)).unwrap();
+            let info = f.replay.finding.as_ref().unwrap();
+            if info.reproduced && !(again.same_as_recorded && again.same_finding) {
+                problems.push(format!("{name}: {} does not replay exactly", f.id));
+            }
+            assert_ne!(
+                info.class,
+                FindingClass::Crash,
+                "{name}: no transport on sim fails"
+            );
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}

@@ -1,0 +1,74 @@
+//! Mutation tests: the reference drive with one planted deviation (`support::mutants`) as the
+//! device under test. Each mutant must fail at least the cases named for it, and every case it
+//! fails must cite one of the requirements the deviation breaks (no collateral failures). The
+//! score is printed.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+mod support;
+
+use drivespec_conform::case::Outcome;
+use drivespec_conform::hpd::HpdSuite;
+use drivespec_conform::link::SimLink;
+use drivespec_conform::select::Pattern;
+use drivespec_conform::suite::{Session, Settings, Suite};
+use support::mutants::{mutants, spec, Mutant};
+
+#[test]
+fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let mut caught = 0;
+    let mut report = Vec::new();
+    let mut problems = Vec::new();
+    let all = mutants();
+    for m in &all {
+        let link = SimLink::new(format!("mutant: {}", m.name), Box::new(Mutant::new(m.kind)));
+        let mut session = suite.session(Box::new(link));
+        let mut failed = Vec::new();
+        for (i, info) in suite.cases().iter().enumerate() {
+            if let Outcome::Fail(f) = session.run(i).outcome {
+                let cites: Vec<String> = f
+                    .requirements
+                    .iter()
+                    .map(|r| r.id.clone())
+                    .chain(info.requirements.iter().cloned())
+                    .collect();
+                if !m.breaks.iter().any(|b| cites.contains(b)) {
+                    problems.push(format!(
+                        "{}: collateral failure {} ({})",
+                        m.name, info.id, f.message
+                    ));
+                }
+                failed.push(info.id.clone());
+            }
+        }
+        for want in m.must_fail {
+            let p = Pattern::new(want).unwrap();
+            if !failed.iter().any(|id| p.matches(id)) {
+                problems.push(format!("{}: {want} did not fail", m.name));
+            }
+        }
+        if !failed.is_empty() {
+            caught += 1;
+        }
+        report.push(format!(
+            "{:<34} breaks {:<40} fails {:>3} case(s)",
+            m.name,
+            m.breaks.join(", ").chars().take(40).collect::<String>(),
+            failed.len()
+        ));
+    }
+    println!("HPD mutants:\n{}", report.join("\n"));
+    println!(
+        "mutation score: {caught}/{} = {:.0} %",
+        all.len(),
+        100.0 * caught as f64 / all.len() as f64
+    );
+    assert!(all.len() >= 12);
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert_eq!(caught, all.len());
+}
