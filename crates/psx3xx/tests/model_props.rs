@@ -263,10 +263,10 @@ fn status_invariants(d: &Drive) {
         d.core().kinematics().vel != 0.0,
         "bit 6, status {s:#06x}"
     );
-    // PSX-STS-2/3: the key pins.
+    // PSX-STS-2-SET-1, PSX-STS-2-RESET-1, PSX-STS-3-SET-1, PSX-STS-3-RESET-1: the key pins.
     assert_eq!(bit(s, 3), d.keys().forward);
     assert_eq!(bit(s, 2), d.keys().reverse);
-    // PSX-STS-0: bit 0 at standstill only within the window of the valid target.
+    // PSX-STS-0-SET-1, PSX-STS-0-RESET-1: bit 0 at standstill only within the window of the valid target.
     if bit(s, 0) && d.run_state() == RunState::Idle {
         let target = d.core().axis().target().expect("bit 0 without a target");
         let window = d.core().axis().values().window;
