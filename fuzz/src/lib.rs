@@ -12,6 +12,7 @@
 )]
 
 pub mod capture;
+pub mod check;
 pub mod hpd;
 pub mod pd;
 pub mod psd4xx;
@@ -40,4 +41,8 @@ pub const TARGETS: &[Target] = &[
     ("capture_iolink", capture::iolink),
     ("psd4xx_model", psd4xx::model),
     ("psx3xx_model", psx3xx::model),
+    ("check_hpd", check::hpd),
+    ("check_profinet", check::profinet),
+    ("check_iolink", check::iolink),
+    ("check_psd4xx", check::psd4xx),
 ];

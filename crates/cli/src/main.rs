@@ -1,5 +1,6 @@
 //! `drivespec`: the command-line front end. Parsing and printing only; the work is in the libraries.
 
+mod check_cmd;
 mod conform_cmd;
 mod fuzz_cmd;
 mod hpd_cmd;
@@ -50,6 +51,8 @@ enum Command {
     Sim(sim_cmd::SimArgs),
     /// Play a script of timed commands on a reference model and print the trace.
     SimRun(simrun_cmd::SimRunArgs),
+    /// Check recorded traffic (pcap/pcapng, serial dumps, IO-Link logs) against the spec.
+    Check(check_cmd::CheckArgs),
     /// Assemble and disassemble PLC programs.
     Plc {
         #[command(subcommand)]
@@ -155,6 +158,7 @@ fn main() -> ExitCode {
         Command::Spec(args) => spec_cmd::run(args, &ctx),
         Command::Conform(args) => conform_cmd::run(args, &ctx),
         Command::Fuzz(args) => fuzz_cmd::run(args, &ctx),
+        Command::Check(args) => check_cmd::run(args, &ctx),
         Command::Sim(args) => sim_cmd::run(args, &ctx),
         Command::SimRun(args) => simrun_cmd::run(args, &ctx),
         Command::Decode { device } => match device {

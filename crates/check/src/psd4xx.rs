@@ -1,0 +1,1062 @@
+//! PSD4xx checks on one drive's traffic (bus description 3.2.2, 3.5–3.8): the PKW
+//! handshake and its answers, control/status relations, values inside the model's ranges,
+//! and acyclic records. The PROFINET checker ([`crate::profinet`]) finds the drive's images
+//! in the cyclic frames and feeds them here in capture order.
+//!
+//! Relations between the controller's output and the drive's input allow for the drive's
+//! processing time: a relation must hold within [`PsdOptions::lag_cycles`] input images (the
+//! toggle-bit echo, the aborted bit after a release withdrawal, the running bit vs the
+//! speed), and a PKW command must be answered within [`PsdOptions::pkw_cycles`].
+//!
+//! The reference model (`drivespec_psd4xx::model::Drive`) is the oracle for parameter writes:
+//! it is seeded with the values the capture shows (PKW and record reads), and every write the
+//! drive accepted or refused is replayed on it to see whether the drive should have refused
+//! it (unknown parameter, read-only, out of range). Values the capture established are
+//! expected back on later reads, except for `live` parameters. Memory is bounded by the
+//! parameter table. Nothing here panics.
+
+use crate::report::{hex, Evidence, Recorder, Where};
+use crate::timeline::{Sample, Timeline};
+use drivespec_psd4xx::model::Drive;
+use drivespec_psd4xx::pkw::PkwRules;
+use drivespec_psd4xx::{
+    CommandCode, ErrorCode, Input, Output, PkwRequest, PkwResponse, RecordShape, Rules, Verdict,
+    Width,
+};
+use drivespec_spec::psd4xx::{PkwOp, PkwValue};
+use drivespec_spec::{DeviceModel, Family};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Requirements checked on every located PSD4xx (bus description 3.2.2, 3.5–3.8).
+pub const CHECKED: &[&str] = &[
+    "PSD-PKW-002",
+    "PSD-PKW-003",
+    "PSD-PKW-006",
+    "PSD-PKW-010",
+    "PSD-PKW-012",
+    "PSD-PKW-013",
+    "PSD-PKW-014",
+    "PSD-PKW-015",
+    "PSD-PKW-016",
+    "PSD-PKW-017",
+    "PSD-PKW-018",
+    "PSD-PKW-019",
+    "PSD-PKW-021",
+    "PSD-PKW-022",
+    "PSD-PKW-023",
+    "PSD-PKW-024",
+    "PSD-PKW-025",
+    "PSD-PKW-026",
+    "PSD-PKW-027",
+    "PSD-PKW-028",
+    "PSD-PKW-030",
+    "PSD-PKW-034",
+    "PSD-PKW-038",
+    "PSD-CTL-13-001",
+    "PSD-CTL-3-001",
+    "PSD-CTL-5-001",
+    "PSD-CTL-7-001",
+    "PSD-CTL-14-001",
+    "PSD-STS-0-PRIO",
+    "PSD-STS-5-SET-1",
+    "PSD-STS-6-SET-1",
+    "PSD-STS-6-RESET-1",
+    "PSD-STS-14-RESET-1",
+    "PSD-STS-15-RESET-1",
+    "PSD-PAR-44-001",
+    "PSD-PAR-RANGE-001",
+    "PSD-REC-006",
+    "PSD-REC-007",
+    "PSD-REC-008",
+    "PSD-REC-009",
+];
+
+/// Options of the PSD4xx checks.
+#[derive(Debug, Clone)]
+pub struct PsdOptions {
+    /// Device model (`PSD426`, matched forgivingly): per-model ranges and the oracle.
+    pub model: Option<String>,
+    /// Input images within which a relation between output and input must hold.
+    pub lag_cycles: u64,
+    /// Input images within which a PKW command must be answered.
+    pub pkw_cycles: u64,
+}
+
+impl Default for PsdOptions {
+    fn default() -> PsdOptions {
+        PsdOptions {
+            model: None,
+            lag_cycles: 20,
+            pkw_cycles: 2000,
+        }
+    }
+}
+
+/// Status and control bits used by the relations (bus description 3.6, 3.7).
+mod bit {
+    pub const TARGET_REACHED: u16 = 1 << 0;
+    pub const TOGGLE_ECHO: u16 = 1 << 2;
+    pub const ABORTED: u16 = 1 << 5;
+    pub const RUNNING: u16 = 1 << 6;
+    pub const OVERLOAD: u16 = 1 << 10;
+    pub const UPPER_LIMIT: u16 = 1 << 14;
+    pub const LOWER_LIMIT: u16 = 1 << 15;
+    pub const MANUAL_UP: u16 = 1 << 0;
+    pub const MANUAL_DOWN: u16 = 1 << 1;
+    pub const TRANSFER: u16 = 1 << 2;
+    pub const RELEASE: u16 = 1 << 4;
+    pub const TOGGLE: u16 = 1 << 13;
+}
+
+/// Parameter numbers the relations use (bus description 3.3).
+mod par {
+    pub const UPPER_LIMIT: u16 = 42;
+    pub const LOWER_LIMIT: u16 = 43;
+    pub const WINDOW: u16 = 44;
+    pub const COMMAND: u16 = 96;
+}
+
+/// A relation that has failed for some input images.
+#[derive(Debug, Clone, Copy, Default)]
+struct Streak {
+    since: Option<(u64, Where)>,
+    reported: bool,
+}
+
+impl Streak {
+    /// Updates the streak; true when it just exceeded `bound` images.
+    fn update(&mut self, failing: bool, n: u64, at: Where, bound: u64) -> Option<Where> {
+        if !failing {
+            *self = Streak::default();
+            return None;
+        }
+        let (start, w) = *self.since.get_or_insert((n, at));
+        if !self.reported && n.saturating_sub(start) >= bound {
+            self.reported = true;
+            return Some(w);
+        }
+        None
+    }
+}
+
+/// The PKW command in force and what became of it.
+#[derive(Debug, Clone, Copy)]
+struct Command {
+    req: PkwRequest,
+    at: Where,
+    /// Input images seen when it was first sent.
+    since: u64,
+    answer: Option<PkwResponse>,
+    reported: bool,
+}
+
+/// A value the capture established for a parameter.
+#[derive(Debug, Clone, Copy)]
+struct Known {
+    value: i64,
+    at: Where,
+}
+
+/// One PSD4xx in a capture (see the module docs).
+pub struct PsdDrive<'s> {
+    label: String,
+    family: &'s Family,
+    rules: Arc<Rules>,
+    model: Option<&'s DeviceModel>,
+    oracle: Option<Drive>,
+    options: PsdOptions,
+    out: Option<Output>,
+    inp: Option<Input>,
+    inputs: u64,
+    command: Option<Command>,
+    last_pkw_out: Option<PkwRequest>,
+    known: BTreeMap<u16, Known>,
+    target: Option<(i32, u64)>,
+    toggle: Streak,
+    run_without_speed: Streak,
+    speed_without_run: Streak,
+    upper: Streak,
+    lower: Streak,
+    window_state: bool,
+    prio_state: bool,
+    abort_pending: Option<(u64, Where)>,
+    spm_state: bool,
+    records: BTreeMap<u16, Vec<u8>>,
+    timeline: Timeline,
+    /// Capture time of the first event: the oracle's clock counts from here.
+    epoch: Option<u64>,
+}
+
+fn command_requirement(rules: &PkwRules, ak: CommandCode) -> &'static str {
+    let Some(info) = rules.command_info(ak) else {
+        return "PSD-PKW-019";
+    };
+    match (info.op, info.array, info.value) {
+        (PkwOp::None, _, _) => "PSD-PKW-006",
+        (PkwOp::Read, false, _) => "PSD-PKW-012",
+        (PkwOp::Read, true, _) => "PSD-PKW-015",
+        (PkwOp::Write, false, Some(PkwValue::Dword)) => "PSD-PKW-014",
+        (PkwOp::Write, false, _) => "PSD-PKW-013",
+        (PkwOp::Write, true, Some(PkwValue::ArrayDword | PkwValue::Dword)) => "PSD-PKW-017",
+        (PkwOp::Write, true, _) => "PSD-PKW-016",
+        (PkwOp::Count, _, _) => "PSD-PKW-018",
+    }
+}
+
+impl<'s> PsdDrive<'s> {
+    /// A drive labelled `label` (the subject of its violations).
+    pub fn new(
+        label: &str,
+        family: &'s Family,
+        rules: Arc<Rules>,
+        model: Option<&'s DeviceModel>,
+        oracle: Option<Drive>,
+        options: PsdOptions,
+    ) -> PsdDrive<'s> {
+        let names = (0..16u32)
+            .map(|b| {
+                rules
+                    .status_bits()
+                    .bit(b)
+                    .map_or_else(|| format!("bit {b}"), |x| x.name.clone())
+            })
+            .collect();
+        PsdDrive {
+            label: label.to_owned(),
+            family,
+            rules,
+            model,
+            oracle,
+            options,
+            out: None,
+            inp: None,
+            inputs: 0,
+            command: None,
+            last_pkw_out: None,
+            known: BTreeMap::new(),
+            target: None,
+            toggle: Streak::default(),
+            run_without_speed: Streak::default(),
+            speed_without_run: Streak::default(),
+            upper: Streak::default(),
+            lower: Streak::default(),
+            window_state: false,
+            prio_state: false,
+            abort_pending: None,
+            spm_state: false,
+            records: BTreeMap::new(),
+            timeline: Timeline::new(label, names),
+            epoch: None,
+        }
+    }
+
+    /// The drive's label.
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+
+    /// The drive's timeline (for the HTML report).
+    pub fn into_timeline(self) -> Timeline {
+        self.timeline
+    }
+
+    fn violation(
+        &mut self,
+        rec: &mut Recorder,
+        id: &str,
+        at: Where,
+        message: impl Into<String>,
+        ev: Evidence,
+    ) {
+        if let Some(t) = at.time {
+            self.timeline.mark(t, id);
+        }
+        rec.violation(id, &self.label, at, message, ev);
+    }
+
+    /// The oracle's time for a capture time: µs since the drive's first event (the model
+    /// simulates every µs it is advanced, so it must not start at 1970).
+    fn model_time(&mut self, at: Where) -> Option<u64> {
+        let t = at.time?;
+        let e = *self.epoch.get_or_insert(t);
+        Some(t.saturating_sub(e))
+    }
+
+    fn pkw(&self) -> &PkwRules {
+        self.rules.pkw()
+    }
+
+    // ------------------------------------------------------------------ output images
+
+    /// An output image (14 bytes, bus description 3.5.1) sent by the controller.
+    pub fn output(&mut self, rec: &mut Recorder, at: Where, bytes: &[u8]) {
+        self.model_time(at);
+        let Ok(out) = Output::parse(&self.rules, bytes) else {
+            return;
+        };
+        let prev = self.out;
+        let prev_control = prev.map(|o| o.control);
+        if prev_control != Some(out.control) {
+            self.control_changed(rec, at, bytes, prev_control, out.control);
+        }
+        if out.control & bit::TRANSFER != 0 && self.target.is_none_or(|(t, _)| t != out.target) {
+            self.target = Some((out.target, self.inputs));
+        }
+        if self.last_pkw_out != Some(out.pkw) {
+            self.pkw_command(rec, at, bytes, out.pkw);
+            self.last_pkw_out = Some(out.pkw);
+        }
+        self.out = Some(out);
+    }
+
+    fn control_changed(
+        &mut self,
+        rec: &mut Recorder,
+        at: Where,
+        bytes: &[u8],
+        prev: Option<u16>,
+        control: u16,
+    ) {
+        let mbz = self.rules.control_bits().must_be_zero_mask() as u16;
+        let bad = control & mbz & !prev.unwrap_or(0);
+        for b in 0..16u16 {
+            if bad & (1 << b) == 0 {
+                continue;
+            }
+            let id = match b {
+                3 => "PSD-CTL-3-001",
+                5 => "PSD-CTL-5-001",
+                7..=12 => "PSD-CTL-7-001",
+                14 | 15 => "PSD-CTL-14-001",
+                _ => "PSD-CTL-ZERO-001",
+            };
+            rec.checks(&[id]);
+            self.violation(
+                rec,
+                id,
+                at,
+                format!("control word {control:#06x} sets reserved bit {b}"),
+                Evidence::bytes(bytes).with("control", format!("{control:#06x}")),
+            );
+        }
+        // Release withdrawn during a positioning run (not a manual run): bit 5 must follow.
+        let p = prev.unwrap_or(0);
+        let running = self.inp.is_some_and(|i| i.status & bit::RUNNING != 0);
+        let manual = p & (bit::MANUAL_UP | bit::MANUAL_DOWN) != 0;
+        if p & bit::RELEASE != 0 && control & bit::RELEASE == 0 && running && !manual {
+            self.abort_pending = Some((self.inputs, at));
+        }
+        if control & bit::RELEASE != 0 {
+            self.abort_pending = None;
+        }
+    }
+
+    fn pkw_command(&mut self, rec: &mut Recorder, at: Where, bytes: &[u8], req: PkwRequest) {
+        if let Some(c) = self.command {
+            let no_command = self.pkw().command_codes().no_command;
+            if c.req.ak != no_command && c.answer.is_none() && self.inputs > c.since {
+                let ev = Evidence::bytes(bytes)
+                    .with("command", self.pkw().describe_request(&c.req))
+                    .with("new_command", self.pkw().describe_request(&req));
+                self.violation(
+                    rec,
+                    "PSD-PKW-002",
+                    at,
+                    format!(
+                        "the controller replaced `{}` (sent at {}) before the drive answered it",
+                        self.pkw().describe_request(&c.req),
+                        c.at
+                    ),
+                    ev,
+                );
+            }
+        }
+        self.command = Some(Command {
+            req,
+            at,
+            since: self.inputs,
+            answer: None,
+            reported: false,
+        });
+    }
+
+    // ------------------------------------------------------------------ input images
+
+    /// An input image (16 bytes, bus description 3.5.2) sent by the drive.
+    pub fn input(&mut self, rec: &mut Recorder, at: Where, bytes: &[u8]) {
+        self.model_time(at);
+        let Ok(inp) = Input::parse(&self.rules, bytes) else {
+            return;
+        };
+        self.inputs += 1;
+        let n = self.inputs;
+        let lag = self.options.lag_cycles;
+        let ev = || {
+            Evidence::bytes(bytes)
+                .with("status", format!("{:#06x}", inp.status))
+                .with("speed", inp.speed)
+                .with("actual", inp.actual)
+        };
+        if let Some(t) = at.time {
+            self.timeline.push(Sample {
+                time: t,
+                actual: i64::from(inp.actual),
+                speed: i64::from(inp.speed),
+                target: self.target.map(|(t, _)| i64::from(t)),
+                status: inp.status,
+                control: self.out.map_or(0, |o| o.control),
+            });
+        }
+        // PSD-STS-0-PRIO: bit 0 wins over bit 10, never both.
+        let both = inp.status & bit::TARGET_REACHED != 0 && inp.status & bit::OVERLOAD != 0;
+        if both && !self.prio_state {
+            self.violation(
+                rec,
+                "PSD-STS-0-PRIO",
+                at,
+                "status bits 0 (target reached) and 10 (overload) are set together",
+                ev(),
+            );
+        }
+        self.prio_state = both;
+        // PSD-CTL-13-001: control bit 13 comes back in status bit 2.
+        if let Some(out) = self.out {
+            let want = out.control & bit::TOGGLE != 0;
+            let have = inp.status & bit::TOGGLE_ECHO != 0;
+            if let Some(w) = self.toggle.update(want != have, n, at, lag) {
+                self.violation(
+                    rec,
+                    "PSD-CTL-13-001",
+                    at,
+                    format!(
+                        "status bit 2 = {} does not echo control bit 13 = {} since {w} ({lag} input images)",
+                        u8::from(have),
+                        u8::from(want)
+                    ),
+                    ev().with("control", format!("{:#06x}", out.control)),
+                );
+            }
+        }
+        // PSD-STS-6: the running bit follows the speed.
+        let running = inp.status & bit::RUNNING != 0;
+        if let Some(w) = self
+            .speed_without_run
+            .update(!running && inp.speed != 0, n, at, lag)
+        {
+            self.violation(
+                rec,
+                "PSD-STS-6-SET-1",
+                at,
+                format!(
+                    "speed {} rpm with status bit 6 (running) clear since {w}",
+                    inp.speed
+                ),
+                ev(),
+            );
+        }
+        if let Some(w) =
+            self.run_without_speed
+                .update(running && inp.speed == 0, n, at, lag.saturating_mul(5))
+        {
+            self.violation(
+                rec,
+                "PSD-STS-6-RESET-1",
+                at,
+                format!("status bit 6 (running) set at speed 0 since {w}"),
+                ev(),
+            );
+        }
+        // PSD-STS-5-SET-1: a positioning run aborted by withdrawing the release sets bit 5.
+        if let Some((since, w)) = self.abort_pending {
+            if inp.status & (bit::ABORTED | bit::TARGET_REACHED) != 0 {
+                self.abort_pending = None;
+            } else if n.saturating_sub(since) >= lag && !running {
+                self.abort_pending = None;
+                self.violation(
+                    rec,
+                    "PSD-STS-5-SET-1",
+                    at,
+                    format!("the release was withdrawn during a run at {w}; the drive stopped without status bit 5"),
+                    ev(),
+                );
+            }
+        }
+        self.window_check(rec, at, &inp, bytes);
+        self.limit_check(rec, at, &inp, bytes);
+        self.pkw_answer(rec, at, bytes, inp.pkw);
+        self.inp = Some(inp);
+    }
+
+    /// PSD-PAR-44-001: bit 0 only inside the positioning window around the target in force.
+    fn window_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
+        let (Some((target, since)), Some(window)) =
+            (self.target, self.known.get(&par::WINDOW).map(|k| k.value))
+        else {
+            return;
+        };
+        let settled = self.inputs.saturating_sub(since) >= self.options.lag_cycles;
+        let reached = inp.status & bit::TARGET_REACHED != 0 && inp.status & bit::RUNNING == 0;
+        let off = (i64::from(inp.actual) - i64::from(target)).abs();
+        let bad = settled && reached && off > window;
+        if bad && !self.window_state {
+            self.violation(
+                rec,
+                "PSD-PAR-44-001",
+                at,
+                format!(
+                    "target reached (status bit 0) at {} while the target is {target}: {off} apart, window (par 44) {window}",
+                    inp.actual
+                ),
+                Evidence::bytes(bytes)
+                    .with("actual", inp.actual)
+                    .with("target", target)
+                    .with("window", window),
+            );
+        }
+        self.window_state = bad;
+    }
+
+    /// PSD-STS-14/15-RESET-1: a limit bit only while the position is at or beyond the limit.
+    fn limit_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
+        let window = self.known.get(&par::WINDOW).map_or(0, |k| k.value);
+        let lag = self.options.lag_cycles;
+        let n = self.inputs;
+        let actual = i64::from(inp.actual);
+        let standstill = inp.status & bit::RUNNING == 0;
+        if let Some(upper) = self.known.get(&par::UPPER_LIMIT).map(|k| k.value) {
+            let bad = standstill && inp.status & bit::UPPER_LIMIT != 0 && actual < upper - window;
+            if let Some(w) = self.upper.update(bad, n, at, lag) {
+                self.violation(
+                    rec,
+                    "PSD-STS-14-RESET-1",
+                    at,
+                    format!("status bit 14 (upper limit) set at {actual}, inside the limit {upper} since {w}"),
+                    Evidence::bytes(bytes).with("actual", actual).with("upper_limit", upper),
+                );
+            }
+        }
+        if let Some(lower) = self.known.get(&par::LOWER_LIMIT).map(|k| k.value) {
+            let bad = standstill && inp.status & bit::LOWER_LIMIT != 0 && actual > lower + window;
+            if let Some(w) = self.lower.update(bad, n, at, lag) {
+                self.violation(
+                    rec,
+                    "PSD-STS-15-RESET-1",
+                    at,
+                    format!("status bit 15 (lower limit) set at {actual}, inside the limit {lower} since {w}"),
+                    Evidence::bytes(bytes).with("actual", actual).with("lower_limit", lower),
+                );
+            }
+        }
+    }
+
+    // ------------------------------------------------------------------ PKW
+
+    fn pkw_answer(&mut self, rec: &mut Recorder, at: Where, bytes: &[u8], resp: PkwResponse) {
+        if resp.spm != self.spm_state && resp.spm {
+            self.violation(
+                rec,
+                "PSD-PKW-010",
+                at,
+                "the drive sets SPM (spontaneous messages are not implemented)",
+                Evidence::bytes(bytes.get(..8).unwrap_or(bytes)),
+            );
+        }
+        self.spm_state = resp.spm;
+        let Some(mut c) = self.command else {
+            return;
+        };
+        let codes = *self.pkw().command_codes();
+        let no_response = self.pkw().response_codes().no_response;
+        let pkw_ev = || Evidence::bytes(bytes.get(..8).unwrap_or(bytes));
+        if c.req.ak == codes.no_command {
+            // PSD-PKW-006: command 0 is answered with response 0.
+            let late = self.inputs.saturating_sub(c.since) > self.options.lag_cycles;
+            if resp.ak != no_response && late && !c.reported {
+                c.reported = true;
+                self.violation(
+                    rec,
+                    "PSD-PKW-006",
+                    at,
+                    format!(
+                        "response `{}` to command 0 (no command, sent at {})",
+                        self.pkw().describe_response(&resp),
+                        c.at
+                    ),
+                    pkw_ev(),
+                );
+            }
+            self.command = Some(c);
+            return;
+        }
+        match c.answer {
+            Some(answer) => {
+                // PSD-PKW-003: the response is held until the controller sends a new command.
+                if resp != answer && !c.reported {
+                    c.reported = true;
+                    self.violation(
+                        rec,
+                        "PSD-PKW-003",
+                        at,
+                        format!(
+                            "the response changed from `{}` to `{}` while the command `{}` stayed",
+                            self.pkw().describe_response(&answer),
+                            self.pkw().describe_response(&resp),
+                            self.pkw().describe_request(&c.req)
+                        ),
+                        pkw_ev(),
+                    );
+                }
+            }
+            None if self.pkw().answers(&c.req, &resp) => {
+                c.answer = Some(resp);
+                self.command = Some(c);
+                self.evaluate(rec, at, bytes, c.req, resp);
+                return;
+            }
+            None => {
+                if self.inputs.saturating_sub(c.since) > self.options.pkw_cycles && !c.reported {
+                    c.reported = true;
+                    self.violation(
+                        rec,
+                        "PSD-PKW-002",
+                        at,
+                        format!(
+                            "no response to `{}` (sent at {}) within {} input images",
+                            self.pkw().describe_request(&c.req),
+                            c.at,
+                            self.options.pkw_cycles
+                        ),
+                        pkw_ev(),
+                    );
+                }
+            }
+        }
+        self.command = Some(c);
+    }
+
+    /// Checks the answer `resp` to `req` (bus description 3.8).
+    fn evaluate(
+        &mut self,
+        rec: &mut Recorder,
+        at: Where,
+        bytes: &[u8],
+        req: PkwRequest,
+        resp: PkwResponse,
+    ) {
+        let rules = self.rules.clone();
+        let pkw = rules.pkw();
+        let ev = Evidence::bytes(bytes.get(..8).unwrap_or(bytes))
+            .with("command", pkw.describe_request(&req))
+            .with("response", pkw.describe_response(&resp));
+        let cannot = pkw.response_codes().cannot_execute;
+        let verdict = pkw.verdict(req.ak, resp.ak);
+        let id = command_requirement(pkw, req.ak);
+        match verdict {
+            Verdict::UnknownCommand => {
+                if resp.ak != cannot {
+                    self.violation(
+                        rec,
+                        "PSD-PKW-019",
+                        at,
+                        format!(
+                            "unknown command {} answered with response {}",
+                            u8::from(req.ak),
+                            u8::from(resp.ak)
+                        ),
+                        ev,
+                    );
+                }
+                return;
+            }
+            Verdict::NotAllowed => {
+                self.violation(
+                    rec,
+                    id,
+                    at,
+                    format!(
+                        "response {} is not an answer the command allows",
+                        u8::from(resp.ak)
+                    ),
+                    ev,
+                );
+                return;
+            }
+            Verdict::Negative => {
+                self.refusal(rec, at, ev, req, resp);
+                return;
+            }
+            Verdict::Positive => {}
+        }
+        let Some(info) = pkw.command_info(req.ak).cloned() else {
+            return;
+        };
+        let param = rules.parameter(u32::from(req.pnu));
+        // A positive answer for a parameter the drive does not have (error 0 is due).
+        if param.is_none() {
+            self.violation(
+                rec,
+                "PSD-PKW-023",
+                at,
+                format!(
+                    "positive answer for parameter {}, which the drive does not have",
+                    req.pnu
+                ),
+                ev,
+            );
+            return;
+        }
+        if let Some(code) = pkw.expected_response(&req) {
+            if code != resp.ak {
+                self.violation(
+                    rec,
+                    id,
+                    at,
+                    format!(
+                        "response {} where the parameter's width calls for {}",
+                        u8::from(resp.ak),
+                        u8::from(code)
+                    ),
+                    ev,
+                );
+                return;
+            }
+        }
+        if let Some(false) = pkw.echo_holds(&req, &resp) {
+            self.violation(
+                rec,
+                "PSD-PKW-034",
+                at,
+                "the answer to the write does not repeat PNU, IND and PWE of the command",
+                ev.clone(),
+            );
+        }
+        let string = pkw.string_access(req.pnu).is_some();
+        let width = if info.array {
+            pkw.element_width(req.pnu)
+        } else {
+            pkw.width(req.pnu)
+        };
+        if let (Some(Width::Word), false) = (width, string) {
+            if pkw.raw_of(resp.pwe, Width::Dword) >> 16 != 0
+                && pkw.pwe_of(pkw.raw_of(resp.pwe, Width::Word), Width::Word, false) != resp.pwe
+                && pkw.pwe_of(pkw.raw_of(resp.pwe, Width::Word), Width::Word, true) != resp.pwe
+            {
+                self.violation(
+                    rec,
+                    "PSD-PKW-038",
+                    at,
+                    format!(
+                        "16-bit value with PWE {:#010x}: the unused word is not 0",
+                        resp.pwe
+                    ),
+                    ev.clone(),
+                );
+            }
+        }
+        if string || info.array || info.op == PkwOp::Count {
+            return;
+        }
+        let Some(width) = width else {
+            return;
+        };
+        let value = pkw.value_of(req.pnu, resp.pwe, width);
+        match info.op {
+            PkwOp::Read => self.read_value(rec, at, req.pnu, value, ev),
+            PkwOp::Write => {
+                let written = pkw.value_of(req.pnu, req.pwe, width);
+                self.accepted_write(rec, at, req.pnu, written, ev);
+            }
+            _ => {}
+        }
+    }
+
+    /// A value the drive reports for `pnu` (PKW or record read).
+    fn read_value(&mut self, rec: &mut Recorder, at: Where, pnu: u16, value: i64, ev: Evidence) {
+        let rules = self.rules.clone();
+        let Some(p) = rules.parameter(u32::from(pnu)) else {
+            return;
+        };
+        if p.range_note.is_none() && (!p.range_model || self.model.is_some()) {
+            if let Some(r) = self.family.resolve(p, self.model).range {
+                if !r.contains(value) {
+                    self.violation(
+                        rec,
+                        "PSD-PAR-RANGE-001",
+                        at,
+                        format!(
+                            "par {pnu} ({}) reads {value}, outside its range {r:?}",
+                            p.name
+                        ),
+                        ev.clone().with("value", value),
+                    );
+                }
+            }
+        }
+        if !p.live {
+            if let Some(k) = self.known.get(&pnu).copied() {
+                if k.value != value {
+                    self.violation(
+                        rec,
+                        "PSD-PKW-021",
+                        at,
+                        format!(
+                            "par {pnu} ({}) reads {value}, but the capture established {} at {}",
+                            p.name, k.value, k.at
+                        ),
+                        ev.with("value", value).with("expected", k.value),
+                    );
+                }
+            }
+            let seedable = p.access.writable() && pnu != par::COMMAND && p.conditions.is_empty();
+            if seedable {
+                let t = self.model_time(at);
+                if let (Some(o), Some(t)) = (self.oracle.as_mut(), t) {
+                    let _ = o.write_parameter(t, pnu, value);
+                }
+            }
+            self.known.insert(pnu, Known { value, at });
+        }
+    }
+
+    /// A write of `value` to `pnu` the drive accepted (PKW or record).
+    fn accepted_write(
+        &mut self,
+        rec: &mut Recorder,
+        at: Where,
+        pnu: u16,
+        value: i64,
+        ev: Evidence,
+    ) {
+        if pnu == par::COMMAND {
+            // Par. 96 restores, resets or saves: every value may change.
+            self.known.clear();
+            return;
+        }
+        let codes = *self.pkw().error_codes();
+        let t = self.model_time(at);
+        let predicted = match (self.oracle.as_mut(), t) {
+            (Some(o), Some(t)) => Some(o.write_parameter(t, pnu, value)),
+            _ => None,
+        };
+        if let Some(Err(e)) = predicted {
+            let id = if e == codes.unknown_parameter {
+                Some("PSD-PKW-023")
+            } else if e == codes.read_only {
+                Some("PSD-PKW-024")
+            } else if e == codes.out_of_range {
+                Some("PSD-PKW-025")
+            } else {
+                None
+            };
+            if let Some(id) = id {
+                let name = self.pkw().errors().name(e).unwrap_or("?").to_owned();
+                self.violation(
+                    rec,
+                    id,
+                    at,
+                    format!(
+                        "the drive accepted par {pnu} = {value}; the reference model refuses it with error {} ({name})",
+                        u32::from(e)
+                    ),
+                    ev.with("value", value),
+                );
+                return;
+            }
+        }
+        let live = self.rules.parameter(u32::from(pnu)).is_none_or(|p| p.live);
+        if !live {
+            self.known.insert(pnu, Known { value, at });
+        }
+    }
+
+    /// Response 7: is the error code plausible for the command, parameter and model?
+    fn refusal(
+        &mut self,
+        rec: &mut Recorder,
+        at: Where,
+        ev: Evidence,
+        req: PkwRequest,
+        resp: PkwResponse,
+    ) {
+        let rules = self.rules.clone();
+        let pkw = rules.pkw();
+        let codes = *pkw.error_codes();
+        let e = ErrorCode::from(resp.pwe);
+        let Some(info) = pkw.command_info(req.ak).cloned() else {
+            return;
+        };
+        if !pkw.errors().contains(e) {
+            self.violation(
+                rec,
+                "PSD-PKW-022",
+                at,
+                format!("error code {} is not in the error table", resp.pwe),
+                ev,
+            );
+            return;
+        }
+        let p = rules.parameter(u32::from(req.pnu));
+        let write = info.op == PkwOp::Write;
+        let width = pkw.width(req.pnu);
+        let value = width.map(|w| pkw.value_of(req.pnu, req.pwe, w));
+        let (plausible, id) = if e == codes.unknown_parameter {
+            (p.is_none(), "PSD-PKW-023")
+        } else if e == codes.read_only {
+            (
+                write && p.is_none_or(|p| !p.access.writable()),
+                "PSD-PKW-024",
+            )
+        } else if e == codes.out_of_range {
+            let outside = match (p, value) {
+                (Some(p), Some(v)) if write => {
+                    p.range_note.is_some()
+                        || (p.range_model && self.model.is_none())
+                        || self
+                            .family
+                            .resolve(p, self.model)
+                            .range
+                            .is_none_or(|r| !r.contains(v))
+                }
+                _ => false,
+            };
+            (outside, "PSD-PKW-025")
+        } else if e == codes.bad_subindex {
+            (info.array, "PSD-PKW-026")
+        } else if e == codes.no_array {
+            (info.array && pkw.elements(req.pnu).is_none(), "PSD-PKW-027")
+        } else if e == codes.wrong_type {
+            let declared = match info.value {
+                Some(PkwValue::Word | PkwValue::ArrayWord) => Some(Width::Word),
+                Some(PkwValue::Dword | PkwValue::ArrayDword) => Some(Width::Dword),
+                _ => None,
+            };
+            let string = pkw.string_access(req.pnu).is_some();
+            (
+                string || (declared.is_some() && declared != width) || p.is_none(),
+                "PSD-PKW-028",
+            )
+        } else if e == codes.operating_state {
+            (
+                write && p.is_none_or(|p| !p.conditions.is_empty() || p.number == 96),
+                "PSD-PKW-030",
+            )
+        } else {
+            (true, "")
+        };
+        if !plausible {
+            let name = pkw.errors().name(e).unwrap_or("?").to_owned();
+            self.violation(
+                rec,
+                id,
+                at,
+                format!(
+                    "error {} ({name}) is not plausible for `{}`",
+                    resp.pwe,
+                    pkw.describe_request(&req)
+                ),
+                ev,
+            );
+        }
+    }
+
+    // ------------------------------------------------------------------ records
+
+    /// A record write request (bus description 3.2.2): index = parameter, control byte, value.
+    pub fn record_write(&mut self, rec: &mut Recorder, at: Where, index: u16, data: &[u8]) {
+        let rr = self.rules.record();
+        let Ok(shape) = rr.shape(index) else {
+            return;
+        };
+        if let RecordShape::Number(w) = shape {
+            let need = rr.write_len(w);
+            if data.len() != need {
+                let id = if w == Width::Word {
+                    "PSD-REC-006"
+                } else {
+                    "PSD-REC-007"
+                };
+                self.violation(
+                    rec,
+                    id,
+                    at,
+                    format!(
+                        "record write of par {index} ({w}) is {} byte(s) long; control byte and value make {need}",
+                        data.len()
+                    ),
+                    Evidence::bytes(data).with("index", index),
+                );
+                return;
+            }
+        }
+        self.records.insert(index, data.to_vec());
+        if self.records.len() > 64 {
+            if let Some(k) = self.records.keys().next().copied() {
+                self.records.remove(&k);
+            }
+        }
+    }
+
+    /// The answer to a record write: `ok` when PNIOStatus is OK.
+    pub fn record_written(&mut self, rec: &mut Recorder, at: Where, index: u16, ok: bool) {
+        let Some(data) = self.records.remove(&index) else {
+            return;
+        };
+        if !ok {
+            return;
+        }
+        let rr = self.rules.record().clone();
+        let Ok(w) = drivespec_psd4xx::RecordWrite::parse(&rr, index, &data) else {
+            return;
+        };
+        if !w.executes(&rr) {
+            return;
+        }
+        let value = w.value;
+        let ev = Evidence::bytes(&data).with("index", index);
+        self.accepted_write(rec, at, index, value, ev);
+    }
+
+    /// The answer to a record read (bus description 3.2.2): 2 or 4 bytes, or the string.
+    pub fn record_read(&mut self, rec: &mut Recorder, at: Where, index: u16, data: &[u8]) {
+        let rr = self.rules.record().clone();
+        let Ok(shape) = rr.shape(index) else {
+            return;
+        };
+        let RecordShape::Number(w) = shape else {
+            return;
+        };
+        let need = rr.read_len(w);
+        if data.len() != need {
+            let id = if w == Width::Word {
+                "PSD-REC-008"
+            } else {
+                "PSD-REC-009"
+            };
+            self.violation(
+                rec,
+                id,
+                at,
+                format!(
+                    "record read of par {index} ({w}) answered with {} byte(s), not {need}",
+                    data.len()
+                ),
+                Evidence::bytes(data)
+                    .with("index", index)
+                    .with("data", hex(data)),
+            );
+            return;
+        }
+        if let Ok(r) = drivespec_psd4xx::RecordRead::parse(&rr, index, data) {
+            if let drivespec_psd4xx::RecordValue::Number { value: v, .. } = r.value {
+                self.read_value(
+                    rec,
+                    at,
+                    index,
+                    v,
+                    Evidence::bytes(data).with("index", index),
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,477 @@
+//! Reports for people and tools: a text summary, JSON (schema `drivespec-check/1`, crate
+//! README), JUnit XML (one test case per requirement checked) and a self-contained HTML page
+//! with a timeline plot (inline SVG) per positioning drive. Output size is bounded by the
+//! reports (violation listing cap, bounded timelines). Nothing here panics.
+
+use crate::report::{format_time, Report, SCHEMA};
+use crate::timeline::Timeline;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// The JSON document of one run: every file's report.
+#[derive(Debug, Serialize)]
+pub struct Document<'a> {
+    /// `drivespec-check/1`.
+    pub schema: &'static str,
+    /// Violations counted over all files.
+    pub violation_count: u64,
+    /// Files whose reading stopped early.
+    pub unreadable: u64,
+    /// One report per file, in the order given.
+    pub reports: &'a [Report],
+}
+
+/// The JSON document of `reports`.
+pub fn json(reports: &[Report]) -> String {
+    let doc = Document {
+        schema: SCHEMA,
+        violation_count: reports.iter().map(|r| r.violation_count).sum(),
+        unreadable: reports.iter().filter(|r| r.error.is_some()).count() as u64,
+        reports,
+    };
+    serde_json::to_string_pretty(&doc)
+        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+}
+
+fn stats_line(s: &crate::report::Stats) -> String {
+    if s.count == 0 {
+        return "-".into();
+    }
+    format!(
+        "mean {:.1} µs, min {:.1}, max {:.1}, σ {:.1}",
+        s.mean, s.min, s.max, s.stddev
+    )
+}
+
+/// The text summary of `reports`.
+pub fn text(reports: &[Report]) -> String {
+    let mut o = String::new();
+    for r in reports {
+        let _ = writeln!(
+            o,
+            "{} [{}]",
+            r.file.as_deref().unwrap_or("(stream)"),
+            r.family
+        );
+        for d in &r.detection {
+            let _ = writeln!(o, "  detected: {d}");
+        }
+        let kinds: Vec<String> = r.frames.iter().map(|(k, n)| format!("{k} {n}")).collect();
+        let _ = writeln!(o, "  events: {}; {}", r.events, kinds.join(", "));
+        for d in &r.drives {
+            let _ = writeln!(
+                o,
+                "  drive: {} (found by {}, confidence {:.2})",
+                d.label, d.found_by, d.confidence
+            );
+        }
+        if !r.streams.is_empty() {
+            let _ = writeln!(o, "  timing:");
+            for s in r.streams.iter().take(50) {
+                let nominal = s
+                    .nominal_us
+                    .map_or(String::new(), |n| format!(", nominal {n:.1} µs"));
+                let jitter = s
+                    .jitter_us
+                    .as_ref()
+                    .filter(|j| j.count > 0)
+                    .map_or(String::new(), |j| format!(", jitter max {:.1} µs", j.max));
+                let missing = if s.missing > 0 {
+                    format!(", {} missing in {} gap(s)", s.missing, s.gaps)
+                } else {
+                    String::new()
+                };
+                let _ = writeln!(
+                    o,
+                    "    {}: {} frames, interval {}{nominal}{jitter}{missing}",
+                    s.stream,
+                    s.frames,
+                    stats_line(&s.interval_us)
+                );
+            }
+            if r.streams.len() > 50 {
+                let _ = writeln!(o, "    … {} more streams", r.streams.len() - 50);
+            }
+        }
+        let checked = r.requirements.len();
+        let _ = writeln!(
+            o,
+            "  requirements checked: {checked}; violations: {}",
+            r.violation_count
+        );
+        for (id, t) in r.requirements.iter().filter(|(_, t)| t.violations > 0) {
+            let _ = writeln!(
+                o,
+                "    {id:<22} {:>6} × [{}] {}",
+                t.violations, t.level, t.text
+            );
+        }
+        if !r.violations.is_empty() {
+            let listed = r.violations.len() as u64;
+            let capped = if listed < r.violation_count {
+                format!(" (first {listed} of {})", r.violation_count)
+            } else {
+                String::new()
+            };
+            let _ = writeln!(o, "  violations{capped}:");
+            for v in &r.violations {
+                let _ = writeln!(
+                    o,
+                    "    {} {} — {}: {}",
+                    v.at, v.requirement, v.subject, v.message
+                );
+                if let Some(b) = &v.evidence.bytes {
+                    let _ = writeln!(o, "        bytes: {b}");
+                }
+                for (k, val) in &v.evidence.fields {
+                    let _ = writeln!(
+                        o,
+                        "        {k}: {}",
+                        val.as_str().map_or_else(|| val.to_string(), str::to_owned)
+                    );
+                }
+            }
+        }
+        for n in &r.notes {
+            let _ = writeln!(o, "  note: {n}");
+        }
+        if r.notes_dropped > 0 {
+            let _ = writeln!(o, "  note: … {} more notes", r.notes_dropped);
+        }
+        if let Some(e) = &r.error {
+            let _ = writeln!(o, "  error: reading stopped: {}", e.message);
+        }
+        let verdict = if r.error.is_some() {
+            "UNREADABLE (checked up to the error)"
+        } else if r.violation_count > 0 {
+            "FAIL"
+        } else {
+            "PASS"
+        };
+        let _ = writeln!(o, "  result: {verdict}");
+    }
+    o
+}
+
+fn xml(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c if (c as u32) < 0x20 && !matches!(c, '\n' | '\t' | '\r') => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// JUnit XML: one test suite per file, one test case per requirement checked (failed when
+/// violated, with the listed violations), plus a test case for a read error.
+pub fn junit(reports: &[Report]) -> String {
+    let mut o = String::from(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"drivespec check\">\n",
+    );
+    for r in reports {
+        let name = r.file.as_deref().unwrap_or("stream");
+        let failures = r.requirements.values().filter(|t| t.violations > 0).count()
+            + usize::from(r.error.is_some());
+        let tests = r.requirements.len() + usize::from(r.error.is_some());
+        let _ = writeln!(
+            o,
+            "  <testsuite name=\"{}\" tests=\"{tests}\" failures=\"{failures}\" errors=\"0\">",
+            xml(name)
+        );
+        for (id, t) in &r.requirements {
+            let _ = write!(
+                o,
+                "    <testcase classname=\"drivespec.check.{}\" name=\"{}\"",
+                xml(&r.family),
+                xml(id)
+            );
+            if t.violations == 0 {
+                o.push_str("/>\n");
+                continue;
+            }
+            o.push_str(">\n");
+            let _ = writeln!(
+                o,
+                "      <failure message=\"{} violation(s): {}\" type=\"{}\">",
+                t.violations,
+                xml(&t.text),
+                xml(&t.level)
+            );
+            for v in r.violations.iter().filter(|v| &v.requirement == id) {
+                let _ = writeln!(
+                    o,
+                    "{}: {}: {}",
+                    xml(&v.at.to_string()),
+                    xml(&v.subject),
+                    xml(&v.message)
+                );
+            }
+            o.push_str("      </failure>\n    </testcase>\n");
+        }
+        if let Some(e) = &r.error {
+            let _ = writeln!(
+                o,
+                "    <testcase classname=\"drivespec.check.input\" name=\"readable\">\n      <failure message=\"{}\" type=\"input\"/>\n    </testcase>",
+                xml(&e.message)
+            );
+        }
+        o.push_str("  </testsuite>\n");
+    }
+    o.push_str("</testsuites>\n");
+    o
+}
+
+/// An SVG timeline: position and target, speed, the 16 status bits, violation marks.
+fn svg(t: &Timeline) -> String {
+    let (w, h_pos, h_speed, row) = (1000.0f64, 200.0f64, 120.0f64, 10.0f64);
+    let h_bits = row * 16.0;
+    let height = h_pos + h_speed + h_bits + 60.0;
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{height}\" viewBox=\"0 0 {w} {height}\" font-family=\"sans-serif\" font-size=\"10\">"
+    );
+    let (Some(first), Some(last)) = (t.samples.first(), t.samples.last()) else {
+        o.push_str("<text x=\"10\" y=\"20\">no samples</text></svg>");
+        return o;
+    };
+    let t0 = first.time as f64;
+    let span = ((last.time as f64) - t0).max(1.0);
+    let left = 60.0;
+    let plot_w = w - left - 10.0;
+    let x = |time: u64| left + ((time as f64 - t0) / span) * plot_w;
+    let range = |vals: &mut dyn Iterator<Item = i64>| {
+        let mut lo = i64::MAX;
+        let mut hi = i64::MIN;
+        for v in vals {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        if lo > hi {
+            (0.0, 1.0)
+        } else if lo == hi {
+            (lo as f64 - 1.0, hi as f64 + 1.0)
+        } else {
+            (lo as f64, hi as f64)
+        }
+    };
+    let (plo, phi) = range(
+        &mut t
+            .samples
+            .iter()
+            .flat_map(|s| std::iter::once(s.actual).chain(s.target)),
+    );
+    let (slo, shi) = range(&mut t.samples.iter().map(|s| s.speed));
+    let y_pos = |v: i64| 10.0 + h_pos - ((v as f64 - plo) / (phi - plo)) * h_pos;
+    let y_speed = |v: i64| 20.0 + h_pos + h_speed - ((v as f64 - slo) / (shi - slo)) * h_speed;
+    let line = |o: &mut String, pts: Vec<(f64, f64)>, color: &str| {
+        if pts.is_empty() {
+            return;
+        }
+        let d: Vec<String> = pts.iter().map(|(a, b)| format!("{a:.1},{b:.1}")).collect();
+        let _ = writeln!(
+            o,
+            "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"1\" points=\"{}\"/>",
+            d.join(" ")
+        );
+    };
+    let _ = writeln!(o, "<text x=\"2\" y=\"20\">position</text><text x=\"2\" y=\"32\">{phi:.0}</text><text x=\"2\" y=\"{:.0}\">{plo:.0}</text>", 10.0 + h_pos);
+    line(
+        &mut o,
+        t.samples
+            .iter()
+            .map(|s| (x(s.time), y_pos(s.actual)))
+            .collect(),
+        "#1f77b4",
+    );
+    line(
+        &mut o,
+        t.samples
+            .iter()
+            .filter_map(|s| s.target.map(|v| (x(s.time), y_pos(v))))
+            .collect(),
+        "#999999",
+    );
+    let _ = writeln!(o, "<text x=\"2\" y=\"{:.0}\">speed</text><text x=\"2\" y=\"{:.0}\">{shi:.0}</text><text x=\"2\" y=\"{:.0}\">{slo:.0}</text>", 30.0 + h_pos, 42.0 + h_pos, 20.0 + h_pos + h_speed);
+    line(
+        &mut o,
+        t.samples
+            .iter()
+            .map(|s| (x(s.time), y_speed(s.speed)))
+            .collect(),
+        "#2ca02c",
+    );
+    let top = 40.0 + h_pos + h_speed;
+    for b in 0..16u16 {
+        let y = top + f64::from(b) * row;
+        let name = t
+            .status_names
+            .get(usize::from(b))
+            .map_or("", String::as_str);
+        let short: String = name.chars().take(10).collect();
+        let _ = writeln!(
+            o,
+            "<text x=\"2\" y=\"{:.0}\"><title>{}</title>{b:>2} {}</text>",
+            y + 8.0,
+            xml(name),
+            xml(&short)
+        );
+        let mut start: Option<u64> = None;
+        for (i, s) in t.samples.iter().enumerate() {
+            let on = s.status & (1 << b) != 0;
+            match (on, start) {
+                (true, None) => start = Some(s.time),
+                (false, Some(st)) => {
+                    let _ = writeln!(o, "<rect x=\"{:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"#ff7f0e\"/>", x(st), (x(s.time) - x(st)).max(0.5), row - 2.0);
+                    start = None;
+                }
+                _ => {}
+            }
+            if i + 1 == t.samples.len() {
+                if let Some(st) = start {
+                    let _ = writeln!(o, "<rect x=\"{:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"#ff7f0e\"/>", x(st), (x(s.time) - x(st)).max(0.5), row - 2.0);
+                }
+            }
+        }
+    }
+    for m in &t.marks {
+        let mx = x(m.time.max(first.time));
+        let _ = writeln!(
+            o,
+            "<line x1=\"{mx:.1}\" y1=\"5\" x2=\"{mx:.1}\" y2=\"{:.0}\" stroke=\"red\" stroke-width=\"1\"><title>{} at {}</title></line>",
+            top + h_bits,
+            xml(&m.requirement),
+            xml(&format_time(m.time))
+        );
+    }
+    let _ = writeln!(
+        o,
+        "<text x=\"{left}\" y=\"{:.0}\">{} … {}</text>",
+        height - 5.0,
+        xml(&format_time(first.time)),
+        xml(&format_time(last.time))
+    );
+    o.push_str("</svg>\n");
+    o
+}
+
+/// A self-contained HTML page of `reports`.
+pub fn html(reports: &[Report]) -> String {
+    let mut o = String::from("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>drivespec check</title>\n<style>body{font-family:sans-serif;margin:1em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;text-align:left;vertical-align:top}.fail{color:#b00}.pass{color:#070}code{font-size:90%}</style></head><body>\n<h1>drivespec check</h1>\n");
+    for r in reports {
+        let verdict = if r.error.is_some() {
+            "<span class=\"fail\">unreadable</span>"
+        } else if r.violation_count > 0 {
+            "<span class=\"fail\">fail</span>"
+        } else {
+            "<span class=\"pass\">pass</span>"
+        };
+        let _ = writeln!(
+            o,
+            "<h2>{} ({}) — {verdict}</h2>",
+            xml(r.file.as_deref().unwrap_or("stream")),
+            xml(&r.family)
+        );
+        o.push_str("<ul>");
+        for d in &r.detection {
+            let _ = write!(o, "<li>{}</li>", xml(d));
+        }
+        let kinds: Vec<String> = r.frames.iter().map(|(k, n)| format!("{k} {n}")).collect();
+        let _ = write!(
+            o,
+            "<li>events {}: {}</li>",
+            r.events,
+            xml(&kinds.join(", "))
+        );
+        for d in &r.drives {
+            let _ = write!(
+                o,
+                "<li>{} — found by {}, confidence {:.2}</li>",
+                xml(&d.label),
+                xml(&d.found_by),
+                d.confidence
+            );
+        }
+        if let Some(e) = &r.error {
+            let _ = write!(
+                o,
+                "<li class=\"fail\">reading stopped: {}</li>",
+                xml(&e.message)
+            );
+        }
+        for n in &r.notes {
+            let _ = write!(o, "<li>{}</li>", xml(n));
+        }
+        o.push_str("</ul>\n");
+        for t in &r.timelines {
+            let _ = writeln!(o, "<h3>{}</h3>", xml(&t.label));
+            o.push_str(&svg(t));
+        }
+        o.push_str("<h3>Requirements</h3><table><tr><th>ID</th><th>level</th><th>violations</th><th>text</th><th>source</th></tr>\n");
+        for (id, t) in &r.requirements {
+            let class = if t.violations > 0 { "fail" } else { "pass" };
+            let _ = writeln!(
+                o,
+                "<tr class=\"{class}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                xml(id),
+                xml(&t.level),
+                t.violations,
+                xml(&t.text),
+                xml(&t.source)
+            );
+        }
+        o.push_str("</table>\n");
+        if !r.violations.is_empty() {
+            let _ = writeln!(o, "<h3>Violations ({} listed of {})</h3><table><tr><th>where</th><th>requirement</th><th>subject</th><th>message</th><th>evidence</th></tr>", r.violations.len(), r.violation_count);
+            for v in &r.violations {
+                let mut ev = v.evidence.bytes.clone().unwrap_or_default();
+                for (k, val) in &v.evidence.fields {
+                    let _ = write!(
+                        ev,
+                        "\n{k}: {}",
+                        val.as_str().map_or_else(|| val.to_string(), str::to_owned)
+                    );
+                }
+                let _ = writeln!(
+                    o,
+                    "<tr><td>{}</td><td title=\"{}\">{}</td><td>{}</td><td>{}</td><td><pre>{}</pre></td></tr>",
+                    xml(&v.at.to_string()),
+                    xml(&v.text),
+                    xml(&v.requirement),
+                    xml(&v.subject),
+                    xml(&v.message),
+                    xml(&ev)
+                );
+            }
+            o.push_str("</table>\n");
+        }
+        if !r.streams.is_empty() {
+            o.push_str("<h3>Timing</h3><table><tr><th>stream</th><th>frames</th><th>nominal µs</th><th>interval µs</th><th>jitter max µs</th><th>missing</th></tr>\n");
+            for s in r.streams.iter().take(200) {
+                let _ = writeln!(
+                    o,
+                    "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    xml(&s.stream),
+                    s.frames,
+                    s.nominal_us.map_or("-".into(), |n| format!("{n:.1}")),
+                    xml(&stats_line(&s.interval_us)),
+                    s.jitter_us
+                        .as_ref()
+                        .filter(|j| j.count > 0)
+                        .map_or("-".into(), |j| format!("{:.1}", j.max)),
+                    s.missing
+                );
+            }
+            o.push_str("</table>\n");
+        }
+    }
+    o.push_str("</body></html>\n");
+    o
+}

@@ -1,0 +1,535 @@
+//! The result of a check: violations with requirement, place and evidence, tallies per
+//! requirement, frame counts, cycle statistics and what was detected (schema in the crate
+//! README, "JSON report").
+//!
+//! Memory is bounded: at most `max_violations` violations are listed (all are counted), the
+//! requirement tallies are bounded by the catalogue, notes by [`MAX_NOTES`], and timelines
+//! by [`crate::timeline::MAX_SAMPLES`]. Nothing here panics.
+
+use crate::timeline::Timeline;
+use drivespec_spec::{Requirement, Spec};
+use serde::Serialize;
+use std::collections::{BTreeMap, HashMap};
+use std::fmt;
+use std::sync::Arc;
+
+/// Name and version of the JSON report schema (crate README, "JSON report").
+pub const SCHEMA: &str = "drivespec-check/1";
+
+/// Most notes kept in one report (the rest are counted in `notes_dropped`).
+pub const MAX_NOTES: usize = 200;
+
+/// The generic PROFINET rules (IEC 61158-6-10), in the spec's requirement format.
+const PROFINET_RULES: &str = include_str!("../profinet.toml");
+
+/// Where something happened (style rule 12: event index and time).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Where {
+    /// 0-based index of the event in the checked stream.
+    pub event: u64,
+    /// Record number in a capture (from 1, as Wireshark counts frames).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frame: Option<u64>,
+    /// Byte offset in the (decompressed) serial stream.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<u64>,
+    /// 1-based line of a text recording or log.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<u64>,
+    /// Microseconds since 1970 (UTC) or since the log's own epoch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<u64>,
+}
+
+impl fmt::Display for Where {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(n) = self.frame {
+            write!(f, "frame {n}")?;
+        } else if let Some(l) = self.line {
+            write!(f, "line {l}")?;
+        } else if let Some(o) = self.offset {
+            write!(f, "byte {o}")?;
+        } else {
+            write!(f, "event {}", self.event)?;
+        }
+        if self.frame.is_some() || self.line.is_some() {
+            if let Some(o) = self.offset {
+                write!(f, ", byte {o}")?;
+            }
+        }
+        if let Some(t) = self.time {
+            write!(f, ", {}", format_time(t))?;
+        }
+        Ok(())
+    }
+}
+
+/// A time for people: ISO 8601 UTC for times after 2000, else seconds since the log's epoch.
+pub fn format_time(us: u64) -> String {
+    const Y2000: u64 = 946_684_800_000_000;
+    if us < Y2000 {
+        return format!("t={}.{:06} s", us / 1_000_000, us % 1_000_000);
+    }
+    let secs = us / 1_000_000;
+    let days = secs / 86_400;
+    let tod = secs % 86_400;
+    let (y, m, d) = civil_from_days(days);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}.{:06}Z",
+        tod / 3600,
+        tod / 60 % 60,
+        tod % 60,
+        us % 1_000_000
+    )
+}
+
+/// Year, month, day of a day count since 1970-01-01 (H. Hinnant's `civil_from_days`).
+fn civil_from_days(days: u64) -> (u64, u64, u64) {
+    let z = days + 719_468;
+    let era = z / 146_097;
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + u64::from(m <= 2);
+    (y, m, d)
+}
+
+/// What shows a violation: the bytes and the decoded fields involved.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Evidence {
+    /// The bytes (hex, blank-separated), when one frame or image shows it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bytes: Option<String>,
+    /// Decoded fields by name.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub fields: BTreeMap<String, serde_json::Value>,
+}
+
+impl Evidence {
+    /// Evidence of the bytes `b`.
+    pub fn bytes(b: &[u8]) -> Evidence {
+        Evidence {
+            bytes: Some(hex(b)),
+            fields: BTreeMap::new(),
+        }
+    }
+
+    /// No bytes, fields to follow.
+    pub fn none() -> Evidence {
+        Evidence::default()
+    }
+
+    /// Adds a decoded field.
+    pub fn with(mut self, name: &str, value: impl Into<serde_json::Value>) -> Evidence {
+        self.fields.insert(name.to_owned(), value.into());
+        self
+    }
+}
+
+/// Hex of bytes, upper case, blank-separated (the spec's hex form).
+pub fn hex(b: &[u8]) -> String {
+    let mut s = String::with_capacity(b.len() * 3);
+    for (i, x) in b.iter().enumerate() {
+        if i > 0 {
+            s.push(' ');
+        }
+        s.push_str(&format!("{x:02X}"));
+    }
+    s
+}
+
+/// One violation of a requirement.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Violation {
+    /// Requirement ID (`HPD-FRAME-009`, `PSD-PKW-034`, `PN-RT-CC-001`).
+    pub requirement: String,
+    /// `must`, `should` or `informative`.
+    pub level: String,
+    /// The requirement in words.
+    pub text: String,
+    /// Where the requirement comes from (manual section or standard).
+    pub source: String,
+    /// What the violation concerns: `drive 3`, `PSD4xx #1 (slot 1)`, `stream 0x8001 …`.
+    pub subject: String,
+    /// Where it happened.
+    #[serde(rename = "where")]
+    pub at: Where,
+    /// What is wrong, one line.
+    pub message: String,
+    /// What shows it.
+    pub evidence: Evidence,
+}
+
+/// How often a requirement was checked and violated.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Tally {
+    /// `must`, `should` or `informative`.
+    pub level: String,
+    /// The requirement in words.
+    pub text: String,
+    /// Where it comes from.
+    pub source: String,
+    /// Violations counted (all of them, whatever `--max-violations` lists).
+    pub violations: u64,
+}
+
+/// Statistics of a series of values (Welford's running mean and variance).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Stats {
+    /// Values seen.
+    pub count: u64,
+    /// Smallest.
+    pub min: f64,
+    /// Largest.
+    pub max: f64,
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation (population).
+    pub stddev: f64,
+    #[serde(skip)]
+    m2: f64,
+}
+
+impl Stats {
+    /// Adds a value.
+    pub fn add(&mut self, x: f64) {
+        self.count += 1;
+        if self.count == 1 {
+            self.min = x;
+            self.max = x;
+        } else {
+            self.min = self.min.min(x);
+            self.max = self.max.max(x);
+        }
+        let delta = x - self.mean;
+        self.mean += delta / self.count as f64;
+        self.m2 += delta * (x - self.mean);
+    }
+
+    /// Computes the standard deviation of the values added so far (kept out of `add`, which
+    /// runs once per frame).
+    pub fn done(mut self) -> Stats {
+        if self.count > 0 {
+            self.stddev = (self.m2 / self.count as f64).sqrt();
+        }
+        self
+    }
+}
+
+/// Timing of one cyclic stream: a PROFINET IOCR, an IO-Link port, an HPD line.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StreamStats {
+    /// What the stream is (`0x8001 00:0e:cf:01:02:03 → 00:1b:1b:0a:0b:0c`, `port 1`).
+    pub stream: String,
+    /// Frames or samples.
+    pub frames: u64,
+    /// Nominal interval in µs (from the Connect, or the most common counter step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_us: Option<f64>,
+    /// Intervals between consecutive frames in µs.
+    pub interval_us: Stats,
+    /// |interval − nominal| in µs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jitter_us: Option<Stats>,
+    /// Frames missing by the cycle counter (sum over gaps).
+    pub missing: u64,
+    /// Gaps (places where at least one frame is missing).
+    pub gaps: u64,
+}
+
+/// A drive found in the capture and how (PROFINET: from the Connect, options or search).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DriveInfo {
+    /// Label used as the subject of its violations.
+    pub label: String,
+    /// Family id (`psd4xx`, `hpd`, `psx3xx`).
+    pub family: String,
+    /// How it was found: `connect`, `options`, `search`, `address`, `port`.
+    pub found_by: String,
+    /// Confidence 0..1 of a search; 1 for a Connect or options.
+    pub confidence: f64,
+    /// Details (frame IDs and offsets, slot/subslot, address).
+    pub details: BTreeMap<String, serde_json::Value>,
+}
+
+/// Reading stopped before the end: the error and where (everything before was checked).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct InputFault {
+    /// The reader's message; it names the offset.
+    pub message: String,
+    /// Byte offset where reading stopped, when known.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<u64>,
+}
+
+/// The report of one check (schema `drivespec-check/1`, crate README).
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// `drivespec-check/1`.
+    pub schema: &'static str,
+    /// The file checked, when a file was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// Checker family: `hpd`, `psd4xx` (PROFINET), `psx3xx`.
+    pub family: String,
+    /// What was detected (format, device) and why.
+    pub detection: Vec<String>,
+    /// Events checked (frames, line events, log lines).
+    pub events: u64,
+    /// Frames or events by kind.
+    pub frames: BTreeMap<String, u64>,
+    /// Violations counted.
+    pub violation_count: u64,
+    /// The listing cap in force (`--max-violations`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_violations: Option<u64>,
+    /// Violations listed, in order of occurrence (at most `max_violations`).
+    pub violations: Vec<Violation>,
+    /// Every requirement checked, with its violation count.
+    pub requirements: BTreeMap<String, Tally>,
+    /// Cycle and timing statistics per stream.
+    pub streams: Vec<StreamStats>,
+    /// Drives found and checked.
+    pub drives: Vec<DriveInfo>,
+    /// Remarks: what could not be checked and why.
+    pub notes: Vec<String>,
+    /// Notes not kept beyond [`MAX_NOTES`].
+    pub notes_dropped: u64,
+    /// Reading stopped early: why and where.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<InputFault>,
+    /// Position, speed and bits over time per positioning drive (HTML report only).
+    #[serde(skip)]
+    pub timelines: Vec<Timeline>,
+}
+
+impl Report {
+    /// An empty report of a family.
+    pub fn new(family: &str) -> Report {
+        Report {
+            schema: SCHEMA,
+            file: None,
+            family: family.to_owned(),
+            detection: Vec::new(),
+            events: 0,
+            frames: BTreeMap::new(),
+            violation_count: 0,
+            max_violations: None,
+            violations: Vec::new(),
+            requirements: BTreeMap::new(),
+            streams: Vec::new(),
+            drives: Vec::new(),
+            notes: Vec::new(),
+            notes_dropped: 0,
+            error: None,
+            timelines: Vec::new(),
+        }
+    }
+
+    /// Whether nothing is wrong: no violation and no read error.
+    pub fn clean(&self) -> bool {
+        self.violation_count == 0 && self.error.is_none()
+    }
+
+    /// Violations counted per requirement ID (only those violated).
+    pub fn counts(&self) -> BTreeMap<&str, u64> {
+        self.requirements
+            .iter()
+            .filter(|(_, t)| t.violations > 0)
+            .map(|(id, t)| (id.as_str(), t.violations))
+            .collect()
+    }
+
+    /// Adds a note, keeping at most [`MAX_NOTES`].
+    pub fn note(&mut self, text: impl Into<String>) {
+        if self.notes.len() < MAX_NOTES {
+            self.notes.push(text.into());
+        } else {
+            self.notes_dropped += 1;
+        }
+    }
+
+    /// Counts one frame or event of `kind`.
+    pub fn count(&mut self, kind: &str) {
+        match self.frames.get_mut(kind) {
+            Some(n) => *n += 1,
+            None => {
+                self.frames.insert(kind.to_owned(), 1);
+            }
+        }
+    }
+
+    /// The JSON form (schema `drivespec-check/1`).
+    pub fn json(&self) -> String {
+        serde_json::to_string_pretty(self)
+            .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+    }
+}
+
+/// One requirement of the catalogue.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct Entry {
+    level: String,
+    text: String,
+    source: String,
+}
+
+/// The catalogue could not be built (a bug in the generic rules file).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("generic PROFINET rules (crates/check/profinet.toml): {0}")]
+pub struct CatalogError(String);
+
+/// Every requirement a checker may cite: the spec's three families and the generic PROFINET
+/// rules of IEC 61158-6-10 (`profinet.toml`).
+#[derive(Debug, Clone)]
+pub struct Catalog {
+    map: HashMap<String, Entry>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RulesFile {
+    requirement: Vec<Requirement>,
+}
+
+impl Catalog {
+    /// The catalogue of `spec` plus the generic PROFINET rules.
+    pub fn new(spec: &Spec) -> Result<Catalog, CatalogError> {
+        let mut map = HashMap::new();
+        let generic: RulesFile =
+            toml::from_str(PROFINET_RULES).map_err(|e| CatalogError(e.to_string()))?;
+        let all = spec
+            .families()
+            .into_iter()
+            .flat_map(|f| f.requirements.iter())
+            .chain(generic.requirement.iter());
+        for r in all {
+            map.insert(
+                r.id.clone(),
+                Entry {
+                    level: r.level.as_str().to_owned(),
+                    text: r.text.clone(),
+                    source: r.source.clone(),
+                },
+            );
+        }
+        Ok(Catalog { map })
+    }
+
+    /// Whether the catalogue has `id`.
+    pub fn has(&self, id: &str) -> bool {
+        self.map.contains_key(id)
+    }
+
+    /// The IDs of the generic PROFINET rules.
+    pub fn generic_ids() -> Vec<String> {
+        toml::from_str::<RulesFile>(PROFINET_RULES)
+            .map(|f| f.requirement.into_iter().map(|r| r.id).collect())
+            .unwrap_or_default()
+    }
+
+    fn entry(&self, id: &str) -> Entry {
+        self.map.get(id).cloned().unwrap_or_else(|| Entry {
+            level: "must".into(),
+            text: format!("(requirement {id} is not in the spec)"),
+            source: String::new(),
+        })
+    }
+}
+
+/// Collects a report: requirements checked, violations with their catalogue text, the cap.
+#[derive(Debug, Clone)]
+pub struct Recorder {
+    catalog: Arc<Catalog>,
+    report: Report,
+    max: Option<u64>,
+}
+
+impl Recorder {
+    /// A recorder for a `family` report listing at most `max` violations.
+    pub fn new(catalog: Arc<Catalog>, family: &str, max: Option<u64>) -> Recorder {
+        let mut report = Report::new(family);
+        report.max_violations = max;
+        Recorder {
+            catalog,
+            report,
+            max,
+        }
+    }
+
+    /// Marks requirements as checked (they appear in the tallies and the JUnit report).
+    pub fn checks(&mut self, ids: &[&str]) {
+        for id in ids {
+            self.tally(id);
+        }
+    }
+
+    fn tally(&mut self, id: &str) -> &mut Tally {
+        let catalog = &self.catalog;
+        self.report
+            .requirements
+            .entry(id.to_owned())
+            .or_insert_with(|| {
+                let e = catalog.entry(id);
+                Tally {
+                    level: e.level,
+                    text: e.text,
+                    source: e.source,
+                    violations: 0,
+                }
+            })
+    }
+
+    /// Records a violation of requirement `id`.
+    pub fn violation(
+        &mut self,
+        id: &str,
+        subject: &str,
+        at: Where,
+        message: impl Into<String>,
+        evidence: Evidence,
+    ) {
+        self.report.violation_count += 1;
+        let t = self.tally(id);
+        t.violations += 1;
+        let (level, text, source) = (t.level.clone(), t.text.clone(), t.source.clone());
+        if self
+            .max
+            .is_none_or(|m| (self.report.violations.len() as u64) < m)
+        {
+            self.report.violations.push(Violation {
+                requirement: id.to_owned(),
+                level,
+                text,
+                source,
+                subject: subject.to_owned(),
+                at,
+                message: message.into(),
+                evidence,
+            });
+        }
+    }
+
+    /// The report being built.
+    pub fn report(&mut self) -> &mut Report {
+        &mut self.report
+    }
+
+    /// The report being built, read-only.
+    pub fn view(&self) -> &Report {
+        &self.report
+    }
+
+    /// The catalogue.
+    pub fn catalog(&self) -> &Arc<Catalog> {
+        &self.catalog
+    }
+
+    /// Ends recording.
+    pub fn finish(self) -> Report {
+        self.report
+    }
+}

@@ -1,0 +1,172 @@
+//! `drivespec check` as users run it on the recordings under `corpus/captures/`: exit codes,
+//! detection, the report formats, `--max-violations`, and a truncated file.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn capture(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../corpus/captures")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn drivespec(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_drivespec"))
+        .args(args)
+        .env("CI", "true")
+        .output()
+        .expect("run drivespec");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn clean_recordings_of_every_family_exit_0_and_say_what_was_detected() {
+    for (file, family, detected) in [
+        ("hpd-clean.socat", "[hpd]", "socat"),
+        ("psd4xx-clean.pcap.gz", "[psd4xx]", "gzip-compressed pcap"),
+        ("psx3xx-clean.csv", "[psx3xx]", "IO-Link CSV"),
+    ] {
+        let (code, out, err) = drivespec(&["check", &capture(file)]);
+        assert_eq!(code, 0, "{file}: {out}{err}");
+        assert!(out.contains(family), "{out}");
+        assert!(out.contains(detected), "{out}");
+        assert!(out.contains("result: PASS"), "{out}");
+    }
+}
+
+#[test]
+fn violations_exit_1_with_requirement_place_and_evidence() {
+    let (code, out, _) = drivespec(&["check", "--baud", "8", &capture("hpd-faults.txt")]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("HPD-SERIAL-012"), "{out}");
+    assert!(out.contains("line "), "{out}");
+    assert!(out.contains("bytes: 7E"), "{out}");
+    assert!(out.contains("result: FAIL"), "{out}");
+}
+
+#[test]
+fn json_report_follows_the_schema_and_counts_beyond_the_listing_cap() {
+    let (code, out, _) = drivespec(&[
+        "check",
+        "--report",
+        "json",
+        "--max-violations",
+        "1",
+        &capture("psd4xx-faults.pcap.gz"),
+    ]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["schema"], "drivespec-check/1");
+    let r = &v["reports"][0];
+    assert_eq!(r["family"], "psd4xx");
+    assert_eq!(r["violations"].as_array().unwrap().len(), 1);
+    assert_eq!(r["violation_count"], 5);
+    assert_eq!(r["drives"][0]["found_by"], "connect");
+    let first = &r["violations"][0];
+    for key in [
+        "requirement",
+        "level",
+        "text",
+        "source",
+        "subject",
+        "where",
+        "message",
+        "evidence",
+    ] {
+        assert!(first.get(key).is_some(), "{key} missing: {first}");
+    }
+    assert!(first["where"]["frame"].is_u64());
+    assert_eq!(r["requirements"]["PSD-PKW-034"]["violations"], 1);
+}
+
+#[test]
+fn the_global_json_format_selects_the_json_report() {
+    let (code, out, _) = drivespec(&["--format", "json", "check", &capture("psx3xx-clean.jsonl")]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["reports"][0]["family"], "psx3xx");
+}
+
+#[test]
+fn junit_and_html_reports_and_the_report_dir() {
+    let (code, out, _) = drivespec(&[
+        "check",
+        "--report",
+        "junit",
+        &capture("psx3xx-faults.jsonl"),
+    ]);
+    assert_eq!(code, 1);
+    assert!(out.starts_with("<?xml"), "{out}");
+    assert!(out.contains("name=\"PSX-GUARD-126-SUPPRESS\""), "{out}");
+    assert!(out.contains("<failure"), "{out}");
+    let dir = std::env::temp_dir().join(format!("drivespec-check-cli-{}", std::process::id()));
+    let (code, out, _) = drivespec(&[
+        "check",
+        "--report",
+        "html",
+        "--report-dir",
+        dir.to_str().unwrap(),
+        &capture("psd4xx-clean.pcap.gz"),
+    ]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("<svg"),
+        "the HTML report plots the drive's timeline"
+    );
+    for f in ["check.txt", "check.json", "check.xml", "check.html"] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_truncated_capture_is_reported_up_to_the_error_and_exits_2() {
+    let (code, out, err) = drivespec(&["check", &capture("psd4xx-truncated.pcap.gz")]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("truncated record at byte"), "{err}");
+    assert!(
+        out.contains("PSD-PKW-034"),
+        "what came before the error is checked: {out}"
+    );
+}
+
+#[test]
+fn options_that_do_not_fit_the_recording_are_bad_usage() {
+    let (code, _, err) = drivespec(&["check", "--device", "psx3xx", &capture("hpd-clean.txt")]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--device psx3xx"), "{err}");
+    let (code, _, err) = drivespec(&["check", "--baud", "12345", &capture("hpd-clean.txt")]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--baud"), "{err}");
+    let (code, _, _) = drivespec(&["check", "/nonexistent/file.pcap"]);
+    assert_eq!(code, 2);
+    let (code, _, _) = drivespec(&["check"]);
+    assert_eq!(code, 2);
+}
+
+#[test]
+fn frame_id_and_offset_locate_the_drive_without_a_connect() {
+    let (code, out, _) = drivespec(&[
+        "check",
+        "--frame-id",
+        "0x8001,0x8000",
+        "--offset",
+        "0",
+        &capture("psd4xx-search.pcap.gz"),
+    ]);
+    assert_eq!(code, 1);
+    assert!(out.contains("found by options"), "{out}");
+    assert!(out.contains("PSD-STS-5-SET-1"), "{out}");
+}
