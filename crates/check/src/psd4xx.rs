@@ -438,7 +438,7 @@ impl<'s> PsdDrive<'s> {
                 );
             }
         }
-        // PSD-STS-6: the running bit follows the speed.
+        // PSD-STS-6-SET-1 / PSD-STS-6-RESET-1: the running bit follows the speed.
         let running = inp.status & bit::RUNNING != 0;
         if let Some(w) = self
             .speed_without_run
@@ -517,7 +517,8 @@ impl<'s> PsdDrive<'s> {
         self.window_state = bad;
     }
 
-    /// PSD-STS-14/15-RESET-1: a limit bit only while the position is at or beyond the limit.
+    /// PSD-STS-14-RESET-1 and PSD-STS-15-RESET-1: a limit bit only while the position is at or
+    /// beyond the limit.
     fn limit_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
         let window = self.known.get(&par::WINDOW).map_or(0, |k| k.value);
         let lag = self.options.lag_cycles;
