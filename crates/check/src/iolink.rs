@@ -19,7 +19,8 @@ use crate::report::{
 use crate::timeline::{Sample, Timeline};
 use drivespec_capture::iolink::{Access, IoLinkError, IoLinkEvent, IoLinkKind, IsduResult};
 use drivespec_psx3xx::isdu::{ErrorCase, ErrorType, Request, Value};
-use drivespec_psx3xx::{ByteOrder, Guards, Input, Output, Rules, WriteFate};
+use drivespec_psx3xx::{ByteOrder, Guards, Input, Output, Rules, StampMeaning, WriteFate};
+use drivespec_spec::psx3xx::RunAction;
 use drivespec_spec::{DeviceModel, FamilyId, Readings, Spec};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -29,7 +30,9 @@ const CHECKED: &[&str] = &[
     "PSX-PD-001",
     "PSX-PD-006",
     "PSX-PD-010",
+    "PSX-TS-001",
     "PSX-TS-003",
+    "PSX-TS-005",
     "PSX-CTL-13-1",
     "PSX-CTL-15-1",
     "PSX-STS-5-SET-1",
@@ -89,6 +92,30 @@ mod isdu {
     pub const DELIVERY: u16 = 193;
 }
 
+/// A time stamp whose command starts a run, not yet executed (manual 3.3.1, 4.4).
+#[derive(Debug, Clone, Copy)]
+struct Armed {
+    /// Control code sent with the stamp.
+    code: u8,
+    /// The stamp value.
+    stamp: u16,
+    /// Delay the stamp encodes, µs.
+    delay_us: u32,
+    /// Log time of the last output carrying it.
+    received: u64,
+    /// Log time the stamp field turned inactive.
+    inactive: Option<u64>,
+}
+
+/// Which reading of the time-stamp errata the checker applies.
+#[derive(Debug, Clone, Copy)]
+struct StampReadings {
+    /// PSX-ERRATUM-064 reading "last-stamp": the delay counts from the stamp's reception.
+    from_last: bool,
+    /// Reading "on-reception" of `psx-ts-immediate`: stamps below the threshold run at once.
+    immediate: bool,
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 struct Streak {
     since: Option<(u64, Where)>,
@@ -123,6 +150,9 @@ struct Port {
     control: Option<u16>,
     target: Option<(i32, u64)>,
     stamp_bad: bool,
+    /// A pending run command by time stamp; cleared by an ISDU write (the control word
+    /// may then change by other means).
+    armed: Option<Armed>,
     reserved: u16,
     inp: Option<Input>,
     toggle_window: bool,
@@ -152,6 +182,7 @@ impl Port {
             control: None,
             target: None,
             stamp_bad: false,
+            armed: None,
             reserved: 0,
             inp: None,
             toggle_window: false,
@@ -176,6 +207,7 @@ pub struct IoLinkChecker<'s> {
     ports: BTreeMap<u8, Port>,
     events: u64,
     readings: Readings,
+    stamps: StampReadings,
 }
 
 fn case_requirement(case: ErrorCase, index: u16, catalog: &Catalog) -> String {
@@ -225,6 +257,11 @@ impl<'s> IoLinkChecker<'s> {
             None => None,
         };
         let order = options.order.unwrap_or_else(|| rules.wire_order());
+        let readings = Readings::default();
+        let stamps = StampReadings {
+            from_last: readings.reading(family, "psx-ts-reference") == Some("last-stamp"),
+            immediate: readings.reading(family, "psx-ts-immediate") == Some("on-reception"),
+        };
         let mut rec = Recorder::new(catalog, "psx3xx", options.max_violations);
         rec.checks(CHECKED);
         Ok(IoLinkChecker {
@@ -235,7 +272,8 @@ impl<'s> IoLinkChecker<'s> {
             rec,
             ports: BTreeMap::new(),
             events: 0,
-            readings: Readings::default(),
+            readings,
+            stamps,
         })
     }
 
@@ -306,6 +344,9 @@ impl<'s> IoLinkChecker<'s> {
                     },
                 };
                 let p = self.port(port);
+                if matches!(access, Access::Write) {
+                    p.armed = None;
+                }
                 if let Some((old, w)) = p.request.take() {
                     let (i, _) = old.address();
                     self.rec.report().note(format!(
@@ -370,6 +411,7 @@ impl<'s> IoLinkChecker<'s> {
                 .with("actual", inp.actual)
         };
         let mut found: Vec<(&'static str, String, Evidence)> = Vec::new();
+        let stamps = self.stamps;
         let p = self.port(port);
         if let Some(t) = at.time {
             p.timeline.push(Sample {
@@ -382,6 +424,15 @@ impl<'s> IoLinkChecker<'s> {
             });
         }
         let running = inp.status & bit::RUNNING != 0;
+        let started = running && p.inp.is_some_and(|i| i.status & bit::RUNNING == 0);
+        let cycle_us = p.interval.mean;
+        let armed = if started { p.armed.take() } else { None };
+        if let (Some(t), Some(armed)) = (at.time, armed) {
+            if let Some((id, msg)) = early_start(&armed, t, cycle_us, stamps) {
+                let e = ev().with("stamp", armed.stamp).with("code", armed.code);
+                found.push((id, msg, e));
+            }
+        }
         if let Some(w) = p
             .speed_without_run
             .update(!running && inp.rpm != 0, n, at, lag)
@@ -437,6 +488,44 @@ impl<'s> IoLinkChecker<'s> {
         }
     }
 
+    /// Tracks a time stamp of a format 0 output (manual 3.3.1, 4.4): a valid stamp with a
+    /// run command arms it (a new valid stamp replaces the pending one, PSX-TS-004); the
+    /// inactive marker releases it (PSX-TS-005).
+    fn arm(&mut self, port: u8, at: Where, code: u8, stamp: u16, meaning: StampMeaning) {
+        let Some(t) = at.time else {
+            return;
+        };
+        let starts_run = self.rules.timestamp().command(code).is_some_and(|c| {
+            matches!(
+                c.action,
+                RunAction::ManualForward
+                    | RunAction::ManualReverse
+                    | RunAction::Position
+                    | RunAction::SafePosition
+            )
+        });
+        let immediate = self.stamps.immediate;
+        let p = self.port(port);
+        match meaning {
+            StampMeaning::Inactive => {
+                if let Some(a) = p.armed.as_mut() {
+                    a.inactive.get_or_insert(t);
+                }
+            }
+            StampMeaning::Immediate { .. } if immediate => p.armed = None,
+            StampMeaning::Immediate { delay_us } | StampMeaning::Delayed { delay_us } => {
+                p.armed = starts_run.then_some(Armed {
+                    code,
+                    stamp,
+                    delay_us,
+                    received: t,
+                    inactive: None,
+                });
+            }
+            StampMeaning::Reserved => {}
+        }
+    }
+
     fn pd_out(&mut self, port: u8, at: Where, bytes: &[u8]) {
         let len = bytes.len();
         let by_len = self.format_of_len(len);
@@ -478,7 +567,7 @@ impl<'s> IoLinkChecker<'s> {
         };
         let mut found: Vec<(&'static str, String)> = Vec::new();
         match out {
-            Output::TimeStamp { stamp, .. } => {
+            Output::TimeStamp { control, stamp } => {
                 let ts = self.rules.timestamp();
                 let valid = stamp.meaning(ts).is_valid() || stamp.meaning(ts).is_inactive();
                 let p = self.port(port);
@@ -492,6 +581,7 @@ impl<'s> IoLinkChecker<'s> {
                     ));
                 }
                 self.port(port).stamp_bad = !valid;
+                self.arm(port, at, control.0, stamp.0, stamp.meaning(ts));
             }
             _ => {
                 let control = out.control_word().unwrap_or(0);
@@ -829,4 +919,43 @@ where
         }
     }
     Ok(c.finish())
+}
+
+/// Whether a run seen starting at log time `t` came before its time stamp allowed
+/// (manual 3.3.1, 4.4): while the stamp was still being sent (PSX-TS-005), or before its delay
+/// ran out (PSX-TS-001), by more than one mean process-data cycle (the log's time resolution).
+fn early_start(
+    armed: &Armed,
+    t: u64,
+    cycle_us: f64,
+    readings: StampReadings,
+) -> Option<(&'static str, String)> {
+    let Some(inactive) = armed.inactive else {
+        return Some((
+            "PSX-TS-005",
+            format!(
+                "the drive started while time stamp {} (control code {}) was still being sent; it may start only after the stamp field turns inactive (0x3FFF)",
+                armed.stamp, armed.code
+            ),
+        ));
+    };
+    let from = if readings.from_last {
+        armed.received
+    } else {
+        inactive
+    };
+    let due = from.saturating_add(u64::from(armed.delay_us));
+    let slack = cycle_us.max(0.0) as u64;
+    (t.saturating_add(slack) < due).then(|| {
+        (
+            "PSX-TS-001",
+            format!(
+                "the drive started {} µs after time stamp {} (control code {}), before its delay of {} µs (stamp × 4 µs) ran out",
+                t.saturating_sub(from),
+                armed.stamp,
+                armed.code,
+                armed.delay_us
+            ),
+        )
+    })
 }

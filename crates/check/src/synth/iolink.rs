@@ -33,11 +33,15 @@ pub enum PsxFault {
     InvalidStamp,
     /// Speed with the running bit clear for 40 samples.
     SpeedWithoutRunning,
+    /// The time-stamp run starts while the stamp is still being sent.
+    StampEarly,
+    /// The time-stamp run starts as the stamp turns inactive, before its delay ran out.
+    StampDelayShort,
 }
 
 impl PsxFault {
     /// Every fault.
-    pub const ALL: [PsxFault; 9] = [
+    pub const ALL: [PsxFault; 11] = [
         PsxFault::OutputLength,
         PsxFault::FormatChange,
         PsxFault::RangeAccepted,
@@ -47,6 +51,8 @@ impl PsxFault {
         PsxFault::ReservedControlBit,
         PsxFault::InvalidStamp,
         PsxFault::SpeedWithoutRunning,
+        PsxFault::StampEarly,
+        PsxFault::StampDelayShort,
     ];
 
     /// The violations (requirement ID, count) the fault gives.
@@ -61,6 +67,8 @@ impl PsxFault {
             PsxFault::ReservedControlBit => &[("PSX-CTL-15-1", 1)],
             PsxFault::InvalidStamp => &[("PSX-TS-003", 1)],
             PsxFault::SpeedWithoutRunning => &[("PSX-STS-6-SET-1", 1)],
+            PsxFault::StampEarly => &[("PSX-TS-005", 1)],
+            PsxFault::StampDelayShort => &[("PSX-TS-001", 1)],
         }
     }
 }
@@ -235,20 +243,42 @@ pub fn psx_log(spec: &Spec, faults: &[PsxFault]) -> Result<Vec<IoLinkEvent>, Syn
         rpm: 0,
         actual: 51200,
     };
-    for (code, s, n) in [
+    // The drive starts once the delay after the last valid stamp has passed (4.4).
+    let delay = stamp.meaning(ts).delay_us().map(u64::from);
+    let mut due = None;
+    for (block, (code, s, n)) in [
         (0u8, inactive, 5),
         (3, inactive, 5),
         (3, stamp, 5),
-        (3, inactive, 20),
-    ] {
+        (3, inactive, 30),
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let out = log.out(Output::TimeStamp {
             control: TsCode(code),
             stamp: s,
         })?;
-        for _ in 0..n {
+        for i in 0..n {
+            let start = match block {
+                2 => has(PsxFault::StampEarly) && i == 2,
+                3 => {
+                    (has(PsxFault::StampDelayShort) && i == 0) || due.is_some_and(|d| log.now >= d)
+                }
+                _ => false,
+            };
+            if start || inp2.status & 0x0040 != 0 {
+                inp2.status = 0x0050;
+                inp2.rpm = 60;
+                inp2.actual += 40;
+            }
+            if block == 2 {
+                due = delay.map(|d| log.now + d);
+            }
             log.pd(2, out.clone(), &inp2)?;
         }
     }
+    inp2.rpm = 0;
     inp2.status = 0x0011;
     let out = log.out(Output::TimeStamp {
         control: TsCode(0),
