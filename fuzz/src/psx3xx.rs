@@ -4,9 +4,10 @@
 
 use drivespec_positioner::EnvChange;
 use drivespec_psx3xx::isdu::{Request, Value};
+use drivespec_psx3xx::model::LedLight;
 use drivespec_psx3xx::model::{Drive, DriveConfig, JogKeys, LinkEvent};
 use drivespec_psx3xx::{Input, Output};
-use drivespec_spec::Spec;
+use drivespec_spec::{FamilyId, Readings, Spec};
 use std::sync::OnceLock;
 
 fn spec() -> &'static Spec {
@@ -14,17 +15,35 @@ fn spec() -> &'static Spec {
     SPEC.get_or_init(|| Spec::builtin().expect("the built-in spec loads"))
 }
 
-/// Drives in the delivery state, one per process-data format and brake option, built once
-/// and cloned per input.
-fn template(format: u8, brake: bool) -> &'static Drive<'static> {
+/// Erratum readings other than the adopted ones, for the drives built with `other` set
+/// (PSX-ERRATUM-011, PSX-ERRATUM-051, PSX-ERRATUM-056, PSX-ERRATUM-064).
+const OTHER_READINGS: &[(&str, &str)] = &[
+    ("psx-signed-measurements", "unsigned"),
+    ("psx-ts-bit-layout", "high-bits"),
+    ("psx-ref-sign", "physical-minus-written"),
+    ("psx-ts-reference", "inactive-marker"),
+];
+
+/// Drives in the delivery state, one per process-data format, brake option and reading set
+/// (adopted or [`OTHER_READINGS`]), built once and cloned per input.
+fn template(format: u8, brake: bool, other: bool) -> &'static Drive<'static> {
     static DRIVES: OnceLock<Vec<Drive<'static>>> = OnceLock::new();
     let drives = DRIVES.get_or_init(|| {
         let mut out = Vec::new();
-        for brake in [false, true] {
+        for (brake, other) in [(false, false), (true, false), (false, true), (true, true)] {
             for f in 0..3u8 {
                 let mut cfg = DriveConfig::new(if brake { "PSE322-14" } else { "PSE312-8" });
                 if brake {
                     cfg = cfg.with_brake(drivespec_psx3xx::model::BrakeKind::Snap);
+                }
+                if other {
+                    let mut readings = Readings::default();
+                    for (option, reading) in OTHER_READINGS {
+                        readings
+                            .choose(spec().family(FamilyId::Psx3xx), option, reading)
+                            .expect("a reading of the spec");
+                    }
+                    cfg = cfg.with_readings(readings);
                 }
                 let mut d = Drive::new(spec(), cfg).expect("model drive");
                 let _ = d.write(0, 116, 0, &Value::Int(i64::from(f)));
@@ -38,7 +57,8 @@ fn template(format: u8, brake: bool) -> &'static Drive<'static> {
         }
         out
     });
-    &drives[usize::from(format % 3) + if brake { 3 } else { 0 }]
+    let set = usize::from(brake) + if other { 2 } else { 0 };
+    &drives[usize::from(format % 3) + 3 * set]
 }
 
 fn word(b: &[u8], i: usize) -> u16 {
@@ -108,12 +128,32 @@ fn check(d: &Drive) {
         "bit 2 is the reverse key"
     );
     assert!(core.kinematics().pos.is_finite() && core.kinematics().vel.is_finite());
+    let leds = d.leds();
+    assert_eq!(
+        leds.green == LedLight::On90Percent,
+        d.link_up(),
+        "the green LED shows the communication (PSX-LED-001, PSX-LED-002)"
+    );
+    assert_eq!(
+        leds.yellow == LedLight::On,
+        core.environment().motor_dv > 0,
+        "the yellow LED shows the motor voltage (PSX-LED-004)"
+    );
+    if d.active_format() != d.rules().timestamp().format {
+        assert_eq!(leds.orange, LedLight::Off, "PSX-LED-003");
+    }
+    assert_eq!(
+        d.value("65"),
+        Value::Int(i64::from(d.input().rpm)),
+        "ISDU 65 is the input's speed under every reading (PSX-ERRATUM-011)"
+    );
 }
 
 /// The model never panics on any sequence of inputs, its outputs come in time order, and the
 /// invariants of 3.3.2 and 3.4 hold after every step.
 ///
-/// Byte 0 picks the format (0–2) and the brake option (bit 2). Then each op byte: high nibble
+/// Byte 0 picks the format (0–2), the brake option (bit 2) and the erratum readings (bit 3:
+/// [`OTHER_READINGS`]). Then each op byte: high nibble
 /// = kind, low nibble = argument length; then the argument. Kinds 0–3 patch the output image
 /// in force and send it, 4 reads and 5 writes an ISDU entry, 6 changes the environment, 7 the
 /// jog keys, 8 the IO-Link communication, 9 cycles the power, 10 writes a number to an entry.
@@ -122,7 +162,7 @@ pub fn model(data: &[u8]) {
     let Some((&first, mut rest)) = data.split_first() else {
         return;
     };
-    let mut d = template(first % 3, first & 4 != 0).clone();
+    let mut d = template(first % 3, first & 4 != 0, first & 8 != 0).clone();
     let mut image: Vec<u8> = Vec::new();
     let mut now = 0u64;
     let (mut last_input, mut last_isdu) = (0, 0);

@@ -7,7 +7,7 @@ use anyhow::{bail, Context as _, Result};
 use drivespec_positioner::script::{RunOptions, Trace};
 use drivespec_psd4xx::model::DriveConfig;
 use drivespec_psd4xx::script as psd_script;
-use drivespec_spec::FamilyId;
+use drivespec_spec::{FamilyId, Readings};
 use std::path::PathBuf;
 
 /// Run a script on a reference model and print what a conforming drive would do.
@@ -27,6 +27,10 @@ pub struct SimRunArgs {
     /// Bus cycle in µs: one output image per cycle.
     #[arg(long, value_name = "US", default_value_t = 1000)]
     cycle_us: u64,
+    /// Another reading of a selectable erratum (`drivespec spec errata`), e.g.
+    /// `psx-ref-sign=physical-minus-written`; repeatable.
+    #[arg(long, value_name = "OPTION=READING")]
+    reading: Vec<String>,
 }
 
 /// Runs `drivespec sim-run`; exit 1 when an `expect` line fails.
@@ -41,19 +45,32 @@ pub fn run(args: SimRunArgs, ctx: &Context) -> Result<Outcome> {
         bail!("--cycle-us 0: the bus cycle is at least 1 µs");
     }
     let spec = ctx.spec()?;
+    let family = FamilyId::parse(&args.device);
+    let mut readings = Readings::default();
+    if let Some(f) = family {
+        for choice in &args.reading {
+            let (option, reading) = choice
+                .split_once('=')
+                .with_context(|| format!("--reading {choice:?}: expected OPTION=READING"))?;
+            readings
+                .choose(spec.family(f), option.trim(), reading.trim())
+                .with_context(|| format!("--reading {choice:?}"))?;
+        }
+    }
     let opts = RunOptions {
         every_ms: args.every,
         cycle_us: args.cycle_us,
         ..RunOptions::default()
     };
-    let trace = match FamilyId::parse(&args.device) {
+    let trace = match family {
         Some(FamilyId::Psd4xx) => {
-            let config = DriveConfig::new(&args.model);
+            let config = DriveConfig::new(&args.model).with_readings(readings);
             psd_script::run_text(&spec, config, &text, &opts)
                 .with_context(|| format!("script {}", args.script.display()))?
         }
         Some(FamilyId::Psx3xx) => {
-            let config = drivespec_psx3xx::model::DriveConfig::new(&args.model);
+            let config =
+                drivespec_psx3xx::model::DriveConfig::new(&args.model).with_readings(readings);
             let trace = drivespec_psx3xx::script::run_text(&spec, config, &text, &opts)
                 .with_context(|| format!("script {}", args.script.display()))?;
             return Ok(print(ctx, &trace));

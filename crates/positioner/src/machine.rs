@@ -375,6 +375,8 @@ struct Filter {
     samples: VecDeque<u16>,
     sum: u64,
     cap: usize,
+    /// How many samples at the back equal the last one (at most all of them).
+    run: usize,
 }
 
 impl Filter {
@@ -383,6 +385,7 @@ impl Filter {
             samples: VecDeque::new(),
             sum: 0,
             cap: cap.max(1),
+            run: 0,
         };
         f.push(value);
         f
@@ -394,8 +397,14 @@ impl Filter {
                 self.sum = self.sum.saturating_sub(u64::from(old));
             }
         }
+        let same = self.samples.back() == Some(&v);
         self.samples.push_back(v);
         self.sum = self.sum.saturating_add(u64::from(v));
+        self.run = if same {
+            self.run.saturating_add(1).min(self.samples.len())
+        } else {
+            1
+        };
     }
 
     fn resize(&mut self, cap: usize) {
@@ -405,6 +414,7 @@ impl Filter {
                 self.sum = self.sum.saturating_sub(u64::from(old));
             }
         }
+        self.run = self.run.min(self.samples.len());
     }
 
     fn value(&self) -> i64 {
@@ -412,8 +422,10 @@ impl Filter {
         i64::try_from(self.sum / n).unwrap_or(0)
     }
 
+    /// Whether every sample equals `v`, in constant time.
     fn settled(&self, v: u16) -> bool {
-        self.samples.iter().all(|s| *s == v)
+        self.samples.is_empty()
+            || (self.samples.back() == Some(&v) && self.run >= self.samples.len())
     }
 }
 
@@ -442,6 +454,14 @@ pub struct Positioner {
     hold: Hold,
     filter: Filter,
     events: VecDeque<(Micros, CoreEvent)>,
+    /// Idle period before the direction of rotation reverses, µs (PSx3xx ISDU 162); 0: none.
+    reversal_pause_us: u64,
+    /// Direction of the last movement: +1, −1, 0 before the first.
+    last_dir: i8,
+    /// When the shaft last came to a stop.
+    stopped_at: Micros,
+    /// The last step held the shaft for the idle period of a reversal.
+    pausing: bool,
 }
 
 fn ms_to_ticks(ms: i64, tick_us: u64) -> usize {
@@ -488,6 +508,10 @@ impl Positioner {
             hold: Hold::Standing,
             filter,
             events: VecDeque::new(),
+            reversal_pause_us: 0,
+            last_dir: 0,
+            stopped_at: 0,
+            pausing: false,
             cfg,
         };
         if p.env.control_dv > 0 {
@@ -794,6 +818,12 @@ impl Positioner {
                 s.kin
             }
         };
+        // PSX-ISDU-162-REVERSE: a driven run that would turn against the last movement first
+        // stands for the idle period, counted from the stop.
+        self.pausing = driving && self.reversing_too_soon(before, next, t);
+        if self.pausing {
+            next = before;
+        }
         let commanded = next.vel;
 
         // Physical constraints: a jammed shaft, load above the torque limit, hard blocks.
@@ -821,6 +851,12 @@ impl Positioner {
         }
         if stalled {
             arrived = false;
+        }
+        // The direction the motor last drove, and when the shaft came to rest.
+        if driving && next.vel != 0.0 {
+            self.last_dir = if next.vel > 0.0 { 1 } else { -1 };
+        } else if next.vel == 0.0 && before.vel != 0.0 {
+            self.stopped_at = t;
         }
         self.kin = next;
         // PSD-STS-6-SET-1, PSD-STS-6-RESET-1: running while the shaft rotates.
@@ -888,6 +924,29 @@ impl Positioner {
             _ => {}
         }
         self.finish_tick();
+    }
+
+    /// Whether the step from `before` to `next` at `t` starts a movement against the last
+    /// one before the idle period since the stop has passed (PSx3xx ISDU 162).
+    fn reversing_too_soon(&self, before: Kinematics, next: Kinematics, t: Micros) -> bool {
+        if self.reversal_pause_us == 0 || before.vel != 0.0 || self.last_dir == 0 {
+            return false;
+        }
+        let against =
+            (next.vel > 0.0 && self.last_dir < 0) || (next.vel < 0.0 && self.last_dir > 0);
+        against && t < self.stopped_at.saturating_add(self.reversal_pause_us)
+    }
+
+    /// Sets the idle period before a reversal of the direction of rotation, ms; 0 reverses
+    /// at once (PSx3xx 3.1 ISDU 162, PSX-ISDU-162-REVERSE).
+    pub fn set_reversal_pause(&mut self, ms: i64) {
+        self.reversal_pause_us = u64::try_from(ms).unwrap_or(0).saturating_mul(1000);
+    }
+
+    /// Whether the drive stands waiting for the idle period before a reversal (PSx3xx 3.1
+    /// ISDU 162).
+    pub fn reversal_pending(&self) -> bool {
+        self.pausing && self.run_kind().is_some()
     }
 
     fn finish_tick(&mut self) {
@@ -1854,5 +1913,32 @@ impl Positioner {
         self.supply_flags();
         self.standstill_checks();
         self.normalize();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Filter;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The constant-time `settled` agrees with comparing every sample (par. 76 filter).
+        #[test]
+        fn filter_settled_matches_every_sample(
+            cap in 1usize..12,
+            ops in proptest::collection::vec((0u16..3, 0usize..14, any::<bool>()), 0..80),
+        ) {
+            let mut f = Filter::new(cap, 1);
+            for (v, new_cap, resize) in ops {
+                if resize {
+                    f.resize(new_cap);
+                } else {
+                    f.push(v);
+                }
+                for probe in 0..3 {
+                    prop_assert_eq!(f.settled(probe), f.samples.iter().all(|s| *s == probe));
+                }
+            }
+        }
     }
 }

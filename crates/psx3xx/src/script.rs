@@ -14,6 +14,7 @@
 //! keys forward|reverse|both|none          jog key inputs (5.10)
 //! link connected|lost                     IO-Link communication (5.9)
 //! power-cycle                             supply off and on again
+//! leds                                    what the three LEDs show (2.6, 3.3.1)
 //! ```
 //!
 //! The master sends the process output of the active format once per cycle; in format 0 it
@@ -62,6 +63,8 @@ pub enum PsxCommand {
     Link(LinkEvent),
     /// Supply off and on again.
     PowerCycle,
+    /// Records what the three LEDs show (2.6, 3.3.1).
+    Leds,
 }
 
 /// The PSx3xx script commands, parsed against the codec tables (issue 5 sim-run).
@@ -122,7 +125,7 @@ impl<'a, 's> PsxDialect<'a, 's> {
     }
 }
 
-const VERBS: &str = "control, target, stamp, isdu, keys, link, power-cycle, env, expect, end";
+const VERBS: &str = "control, target, stamp, isdu, keys, link, power-cycle, leds, env, expect, end";
 
 fn word_in<'t>(what: &'static str, text: &'t str, allowed: &str) -> Result<&'t str, LineError> {
     let (w, tail) = split_word(text);
@@ -201,6 +204,10 @@ impl Dialect for PsxDialect<'_, '_> {
             "power-cycle" => {
                 no_more(rest)?;
                 Ok(PsxCommand::PowerCycle)
+            }
+            "leds" => {
+                no_more(rest)?;
+                Ok(PsxCommand::Leds)
             }
             other => Err(LineError::Unknown {
                 what: "command",
@@ -401,6 +408,17 @@ impl<'s> Simulated for PsxSim<'s> {
             PsxCommand::Keys(k) => self.drive.handle_keys(now, *k),
             PsxCommand::Link(ev) => self.drive.handle_link(now, *ev),
             PsxCommand::PowerCycle => self.drive.power_cycle(now),
+            PsxCommand::Leds => {
+                self.drive.advance(now);
+                let l = self.drive.leds();
+                let shown = format!(
+                    "green {}, orange {}, yellow {}",
+                    l.green.pattern(),
+                    l.orange.pattern(),
+                    l.yellow.pattern()
+                );
+                rec.answer(now, "leds".to_owned(), shown, String::new());
+            }
         }
     }
 

@@ -26,11 +26,13 @@ const SOURCES: &[&str] = &[
 ];
 
 const TESTS: &[&str] = &[
+    include_str!("model_errata.rs"),
     include_str!("model_features.rs"),
     include_str!("model_parameters.rs"),
     include_str!("model_position.rs"),
     include_str!("model_positioning.rs"),
     include_str!("model_props.rs"),
+    include_str!("model_requirements.rs"),
     include_str!("model_traces.rs"),
     include_str!("model_vectors.rs"),
 ];

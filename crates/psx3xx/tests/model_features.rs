@@ -88,6 +88,7 @@ fn psx_adj_005_readjust_starts_when_the_window_is_left() {
     s.env(EnvChange::Displace { by: -2 });
     assert_eq!(s.run(), "none");
     assert!(s.bit(0));
+    // PSX-ADJ-005: one step beyond the window starts the readjustment.
     s.env(EnvChange::Displace { by: -1 });
     assert_eq!(s.run(), "positioning");
     // PSX-STS-11-SET-1.
@@ -150,6 +151,7 @@ fn psx_timeout_002_006_no_timeout_with_isdu_118_zero() {
     let mut s = Sim::new("PSE312-8");
     s.f1(0x14, 90000);
     s.link(LinkEvent::Lost);
+    // PSX-TIMEOUT-002: ISDU 118 = 0, the run ends as planned.
     s.settle(120_000);
     assert_eq!(s.actual(), 90000);
     assert!(s.bit(0));
@@ -474,4 +476,42 @@ fn psx_pos_001_encoder_covers_256_revolutions() {
     // PSX-STS-9-BLOCK.
     s.f1(0x14, 50_000);
     assert_eq!(s.run(), "none");
+}
+
+#[test]
+fn psx_timeout_005_safe_run_of_a_brake_drive_waits_for_the_brake() {
+    let mut s = Sim::with(DriveConfig::new("PSE322-14").with_brake(BrakeKind::Snap));
+    s.write_ok(118, 100);
+    s.write_ok(137, 2);
+    s.write_ok(138, 50_000);
+    s.link(LinkEvent::Lost);
+    s.run_ms(101);
+    // PSX-TIMEOUT-005, PSX-BRAKE-003: ISDU 164 first, then the run to ISDU 138.
+    assert_eq!(s.drive.run_state(), RunState::BrakeWait);
+    s.until(1_000, |d| d.run_state() != RunState::BrakeWait);
+    assert_eq!(
+        s.drive.run_state(),
+        RunState::SafePosition { target: 50_000 }
+    );
+    s.settle(60_000);
+    assert_eq!(s.actual(), 50_000);
+    // The master returns and withdraws the release while the brake is still closed: the
+    // next run is an ordinary positioning.
+    let mut s = Sim::with(DriveConfig::new("PSE322-14").with_brake(BrakeKind::Snap));
+    s.write_ok(118, 100);
+    s.write_ok(137, 2);
+    s.write_ok(138, 50_000);
+    s.link(LinkEvent::Lost);
+    s.run_ms(101);
+    assert_eq!(s.drive.run_state(), RunState::BrakeWait);
+    s.link(LinkEvent::Connected);
+    s.f1(0x00, 0);
+    s.run_ms(500);
+    assert_eq!(s.run(), "none");
+    s.f1(0x14, 52_000);
+    s.until(1_000, |d| d.run_state() != RunState::BrakeWait);
+    assert_eq!(
+        s.drive.run_state(),
+        RunState::Positioning { target: 52_000 }
+    );
 }

@@ -430,7 +430,8 @@ fn psx_ctl_13_15_reserved_control_bits() {
 #[test]
 fn psx_dp_009_direct_parameters_through_isdu_0() {
     let mut s = Sim::new("PSE312-8");
-    // PSX-DP-001 … PSX-DP-006, PSX-ISDU-0-RESERVED.
+    // PSX-DP-001 … PSX-DP-006 (PSX-DP-002 sub 4, PSX-DP-003 sub 5, PSX-DP-004 sub 6),
+    // PSX-ISDU-0-RESERVED.
     for (sub, want) in [
         (3, 0x44),
         (4, 0x2B),

@@ -369,3 +369,21 @@ fn formula_vectors_come_out_as_the_manual_says() {
         }
     }
 }
+
+/// Requirements the model checks through the position vectors that list them: each one is
+/// listed by at least one vector, and every vector listing it passes (not merely
+/// acceptable).
+#[test]
+fn requirements_checked_through_position_vectors() {
+    for id in ["PSX-MAP-006", "PSX-POS-003", "PSX-POS-012", "PSX-RUN-005"] {
+        let listing: Vec<&Vector> = family()
+            .vectors
+            .iter()
+            .filter(|v| v.kind == VectorKind::Position && v.requirements.iter().any(|r| r == id))
+            .collect();
+        assert!(!listing.is_empty(), "no position vector lists {id}");
+        for v in listing {
+            assert_eq!(run(v), Ok(()), "{id}: vector {}", v.id);
+        }
+    }
+}

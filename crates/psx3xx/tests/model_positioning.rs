@@ -51,6 +51,7 @@ fn psx_cmd_001_format_1_positioning_reaches_target() {
 fn psx_run_002_003_loop_cases_forward_and_backward() {
     let mut s = Sim::new("PSE312-8");
     while s.drive.poll_event().is_some() {}
+    // PSX-RUN-001: with the delivery loop both targets are approached forwards (ISDU 134 = 0).
     // Case 2 (PSX-RUN-003, PSX-STS-8-SET-2): below, overrun by 250 and approach forward.
     s.f1(0x14, 50000);
     assert_eq!(waypoints(&mut s), vec![vec![49750, 50000]]);
@@ -170,7 +171,7 @@ fn psx_cmd_002_sts_5_set_1_release_withdrawn_cancels() {
     s.f1(0x14, 90000);
     s.run_ms(500);
     s.f1(0x00, 90000);
-    // PSX-STS-5-SET-1, PSX-CTL-4-3.
+    // PSX-CMD-002: control word 0x00 cancels the run; PSX-STS-5-SET-1, PSX-CTL-4-3.
     assert!(s.bit(5));
     s.settle(10_000);
     assert!(s.actual() < 90000);
@@ -265,6 +266,7 @@ fn psx_ts_009_reserved_stamps_are_ignored() {
 fn psx_ts_012_pd_012_run_without_loop_through_isdu_110() {
     let mut s = format("PSE312-8", 0);
     s.f0(0, 0x3FFF);
+    // PSX-TS-012: bit 6 set beforehand through ISDU 110.
     s.write_ok(110, 0x40);
     s.write_ok(112, 50000);
     while s.drive.poll_event().is_some() {}
@@ -278,7 +280,8 @@ fn psx_ts_012_pd_012_run_without_loop_through_isdu_110() {
 fn psx_ts_011_manual_run_by_stamp() {
     let mut s = format("PSE312-8", 0);
     s.f0(0, 0x3FFF);
-    // PSX-ERRATUM-053 "after-disable": the code alone does not start.
+    // PSX-TS-011: stamp inactive, code 1, stamp, stamp inactive; the run starts after the
+    // delay. PSX-ERRATUM-053 "after-disable": the code alone does not start.
     s.f0(1, 0x3FFF);
     assert_eq!(s.run(), "none");
     s.f0(1, 5000);

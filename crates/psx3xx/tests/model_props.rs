@@ -13,7 +13,7 @@ mod model_util;
 
 use drivespec_positioner::{EnvChange, Micros};
 use drivespec_psx3xx::isdu::Value;
-use drivespec_psx3xx::model::{Drive, DriveConfig, JogKeys, LinkEvent, RunState};
+use drivespec_psx3xx::model::{Drive, DriveConfig, JogKeys, LedLight, LinkEvent, RunState};
 use drivespec_psx3xx::{Output, Stamp, TsCode};
 use model_util::*;
 use proptest::prelude::*;
@@ -280,6 +280,32 @@ fn status_invariants(d: &Drive) {
     assert!(k.pos.is_finite() && k.vel.is_finite());
     let image = d.input_image();
     assert_eq!(image.len(), 8);
+    // PSX-LED-001, PSX-LED-002, PSX-LED-003, PSX-LED-004.
+    let leds = d.leds();
+    assert_eq!(leds.green == LedLight::On90Percent, d.link_up());
+    assert_eq!(
+        leds.yellow == LedLight::On,
+        d.core().environment().motor_dv > 0
+    );
+    if d.active_format() != 0 {
+        assert_eq!(leds.orange, LedLight::Off);
+    }
+}
+
+/// The drive with the readings other than the adopted ones where a reading changes what a
+/// run does or shows (PSX-ERRATUM-011, PSX-ERRATUM-051, PSX-ERRATUM-056).
+fn drive_other_readings(format: u8) -> (Drive<'static>, Micros) {
+    let cfg = DriveConfig::new("PSE312-8").with_readings(readings(&[
+        ("psx-signed-measurements", "unsigned"),
+        ("psx-ts-bit-layout", "high-bits"),
+        ("psx-ref-sign", "physical-minus-written"),
+    ]));
+    let mut d = Drive::new(spec(), cfg).unwrap();
+    let _ = d.write(0, 116, 0, &Value::Int(i64::from(format)));
+    let _ = d.write(0, 193, 0, &Value::Int(1));
+    let _ = d.write(0, 2, 0, &Value::Int(128));
+    assert_eq!(d.active_format(), format);
+    (d, 0)
 }
 
 proptest! {
@@ -321,6 +347,28 @@ proptest! {
                 cap_seen = cap_seen.max(caps[0].max(caps[1]));
                 let rpm = d.core().speed_rpm().abs();
                 assert!(rpm <= cap_seen + 1, "{rpm} rpm above the caps {caps:?}");
+            });
+        }
+    }
+
+    /// Under the other readings the invariants hold too, ISDU 65 and the input's speed are
+    /// never negative (PSX-ISDU-65-UNIT) and ISDU 127 is the negated referencing value of
+    /// the core (PSX-POS-009).
+    #[test]
+    fn other_readings_keep_the_invariants(format in 0u8..3, ops in ops(true, true)) {
+        let (mut d, mut now) = drive_other_readings(format);
+        for op in &ops {
+            apply(&mut d, &mut now, op, &mut |d| {
+                status_invariants(d);
+                if d.core().powered() {
+                    assert!(d.input().rpm >= 0);
+                    assert_eq!(d.value("65"), Value::Int(i64::from(d.input().rpm)));
+                    let reference = d.core().get(drivespec_positioner::machine::Setting::Reference);
+                    let shown = reference
+                        .saturating_neg()
+                        .clamp(i64::from(i32::MIN), i64::from(i32::MAX));
+                    assert_eq!(d.value("127"), Value::Int(shown));
+                }
             });
         }
     }

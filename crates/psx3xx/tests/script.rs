@@ -7,7 +7,7 @@
     clippy::panic
 )]
 
-use drivespec_positioner::script::{Action, LineError, RunOptions};
+use drivespec_positioner::script::{Action, LineError, RunOptions, What};
 use drivespec_psx3xx::isdu::Request;
 use drivespec_psx3xx::model::{DriveConfig, JogKeys, LinkEvent};
 use drivespec_psx3xx::script::{parse, run_text, PsxCommand};
@@ -81,4 +81,46 @@ fn runs_are_deterministic() {
     assert_eq!(a, b);
     assert_eq!(a.family, "psx3xx");
     assert!(a.entries.len() > 4);
+}
+
+#[test]
+fn leds_command_records_the_three_leds() {
+    let spec = Spec::builtin().unwrap();
+    let text = "0 ms: leds\n10 ms: link lost\n20 ms: env motor-voltage 0\n30 ms: leds\n";
+    let trace = run_text(
+        &spec,
+        DriveConfig::new("PSE312-8"),
+        text,
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let shown: Vec<String> = trace
+        .entries
+        .iter()
+        .filter_map(|e| match &e.what {
+            What::Answer {
+                channel, answer, ..
+            } if channel == "leds" => Some(answer.clone()),
+            _ => None,
+        })
+        .collect();
+    // PSX-LED-001, PSX-LED-002, PSX-LED-003, PSX-LED-004 as the spec names the patterns.
+    assert_eq!(
+        shown,
+        [
+            "green on-90-percent, orange off, yellow on",
+            "green off, orange off, yellow off"
+        ]
+    );
+    for pattern in ["on-90-percent", "off", "on"] {
+        assert!(
+            spec.family(FamilyId::Psx3xx)
+                .psx3xx()
+                .unwrap()
+                .leds
+                .iter()
+                .any(|l| l.states.iter().any(|s| s.pattern == pattern)),
+            "{pattern} is a spec pattern"
+        );
+    }
 }

@@ -2,7 +2,7 @@
 //! in force to the core's commands with the PSx3xx run-start rules, time stamps, jog keys and
 //! bits, the brake, the master time-out, the drag error and the speed limits in force.
 
-use super::drive::{Deferred, Drive, FamilyRun, Ideal, JogMode, PendingStamp};
+use super::drive::{Deferred, Drive, FamilyRun, Hot, Ideal, JogMode, PendingStamp};
 use super::family::{ReservedStamp, Role};
 use super::io::Event;
 use crate::{Output, Stamp, StampMeaning};
@@ -43,6 +43,20 @@ impl Drive<'_> {
             .copied()
             .or_else(|| self.fam.by_id(id).and_then(|e| e.default))
             .unwrap_or(0)
+    }
+
+    /// Copies the working values read on every step out of the map; called whenever the
+    /// map changes (manual 3.1 ISDU 118, 142–145, 162).
+    pub(super) fn refresh_hot(&mut self) {
+        let ids = &self.fam.ids;
+        self.hot = Hot {
+            timeout: self.val(&ids.timeout),
+            speed_positioning: self.val(&ids.speed_positioning),
+            speed_manual: self.val(&ids.speed_manual),
+            speed_ccw: self.val(&ids.speed_ccw),
+            speed_cw: self.val(&ids.speed_cw),
+            reversal_pause: self.val(&ids.reversal_pause),
+        };
     }
 
     fn val_opt(&self, id: Option<&str>) -> i64 {
@@ -302,6 +316,8 @@ impl Drive<'_> {
     fn stamp_input(&mut self, now: Micros, code: u8, stamp: Stamp) {
         let ts = self.rules.timestamp();
         let mut meaning = stamp.meaning(ts);
+        // PSX-LED-006: a valid stamp in the image keeps the orange LED dark.
+        self.stamp_streaming = meaning.is_valid();
         if meaning == StampMeaning::Reserved {
             // PSX-ERRATUM-061.
             meaning = match self.fam.options.stamp_reserved {
@@ -372,6 +388,8 @@ impl Drive<'_> {
         let mask = ts.control_word_mask;
         let old = self.control;
         self.control = (old & !mask) | (word & mask);
+        // PSX-LED-005: the orange LED acknowledges the stamp with its dark phase.
+        self.stamp_fired_at = Some(now);
         self.event(now, Event::StampFired { code });
         self.control_changed(now, old);
     }
@@ -640,6 +658,13 @@ impl Drive<'_> {
         self.run_started_at = at;
         self.max_torque = 0;
         self.brake_close_at = None;
+        // A run to another target than the safe position is not the time-out's run (the
+        // safe run may have waited for the brake and been dropped meanwhile).
+        if let FamilyRun::Safe(safe) = self.family_run {
+            if self.core.run_target() != Some(safe) {
+                self.family_run = FamilyRun::None;
+            }
+        }
         let family_hook = matches!(
             self.family_run,
             FamilyRun::ReferenceLoop { .. } | FamilyRun::Step(_)
@@ -864,7 +889,7 @@ impl Drive<'_> {
 
     /// When the master time-out strikes (PSX-TIMEOUT-003, PSX-TIMEOUT-006).
     pub(super) fn watchdog(&self) -> Option<Micros> {
-        let limit = self.val(&self.fam.ids.timeout);
+        let limit = self.hot.timeout;
         (limit > 0 && !self.timed_out && self.core.powered())
             .then(|| self.last_rx.saturating_add(ms(limit)))
     }
@@ -900,7 +925,11 @@ impl Drive<'_> {
             self.stop_jog(now);
         }
         self.control_changed(now, old);
-        if action == RunAction::SafePosition && self.core.run_target().is_none() {
+        // A run that waits for the brake (5.12, 5.13) is still the run to the safe position.
+        if action == RunAction::SafePosition
+            && self.core.run_target().is_none()
+            && self.deferred.is_none()
+        {
             self.family_run = FamilyRun::None;
         }
     }
@@ -932,8 +961,8 @@ impl Drive<'_> {
     }
 
     fn update_speeds_for(&mut self, run: FamilyRun) {
-        let ids = &self.fam.ids;
-        let (cw, ccw) = (self.val(&ids.speed_cw), self.val(&ids.speed_ccw));
+        let hot = self.hot;
+        let (cw, ccw) = (hot.speed_cw, hot.speed_ccw);
         // PSX-ISDU-123-MEANING: direction 0 turns clockwise for increasing positions.
         let up_is_cw = self.core.get(Setting::Direction) == 0;
         let (up, down) = if up_is_cw { (cw, ccw) } else { (ccw, cw) };
@@ -948,7 +977,7 @@ impl Drive<'_> {
         let ts = &self.rules.protocol().target_speed;
         let pd = (self.active_format == ts.format && self.pd_speed > ts.use_parameter_value)
             .then_some(self.pd_speed);
-        let manual_isdu = self.val(&ids.speed_manual);
+        let manual_isdu = hot.speed_manual;
         let hook_manual = matches!(
             run,
             FamilyRun::Step(_) | FamilyRun::Continuous(_) | FamilyRun::ReferenceLoop { .. }
@@ -957,7 +986,7 @@ impl Drive<'_> {
             (manual_isdu, manual_isdu)
         } else {
             (
-                pd.unwrap_or(self.val(&ids.speed_positioning)),
+                pd.unwrap_or(hot.speed_positioning),
                 pd.unwrap_or(manual_isdu),
             )
         };
@@ -982,12 +1011,20 @@ impl Drive<'_> {
         if self.core.get(Setting::ManualSpeed) != man {
             let _ = self.core.set(now, Setting::ManualSpeed, man);
         }
+        // PSX-ISDU-162-REVERSE: the idle period before a reversal.
+        self.core.set_reversal_pause(hot.reversal_pause);
     }
 
     /// The computed set position and the drag error (PSX-STS-1-SET-1, PSX-STS-1-SET-2,
     /// PSX-ERRATUM-010), and the drag error correction of control bit 12 (PSX-CTL-12-1,
     /// PSX-CTL-12-2).
     fn update_drag(&mut self) {
+        // The computed position waits with the drive for the idle period of a reversal
+        // (PSX-ISDU-162-REVERSE).
+        if self.core.reversal_pending() {
+            self.correction_rpm = 0;
+            return;
+        }
         let Some(mut ideal) = self.ideal.take() else {
             self.correction_rpm = 0;
             return;

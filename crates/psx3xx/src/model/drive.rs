@@ -4,7 +4,7 @@
 use super::config::DriveConfig;
 use super::error::ModelError;
 use super::family::PsxFamily;
-use super::io::{Event, IsduAnswer, JogKeys, LinkEvent, RunState};
+use super::io::{Event, IsduAnswer, JogKeys, LedLight, Leds, LinkEvent, RunState};
 use crate::guard::Guards;
 use crate::{ImageError, Input, Output, Rules};
 use drivespec_positioner::machine::Command;
@@ -84,6 +84,18 @@ pub(super) struct Ideal {
     pub top_checked: bool,
 }
 
+/// Stored values the drive reads on every step, kept apart from the map of working values
+/// and refreshed whenever those change (manual 3.1 ISDU 118, 142–145, 162).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(super) struct Hot {
+    pub timeout: i64,
+    pub speed_positioning: i64,
+    pub speed_manual: i64,
+    pub speed_ccw: i64,
+    pub speed_cw: i64,
+    pub reversal_pause: i64,
+}
+
 /// A reference PSx3xx drive on virtual time (manual chapters 3–5).
 ///
 /// Inputs: process output images ([`Drive::handle_image`], [`Drive::handle_output`]), ISDU
@@ -102,6 +114,8 @@ pub struct Drive<'s> {
     pub(super) order: ByteOrder,
     /// Working values of stored numeric entries, by parameter id.
     pub(super) values: BTreeMap<String, i64>,
+    /// The working values read on every step ([`Drive::refresh_hot`]).
+    pub(super) hot: Hot,
     /// Working values of writable text entries.
     pub(super) texts: BTreeMap<String, String>,
     /// The EEPROM image of the saved entries.
@@ -114,6 +128,10 @@ pub struct Drive<'s> {
     pub(super) transfer_pulse: bool,
     pub(super) stamp: Option<PendingStamp>,
     pub(super) stamp_due: Option<(Micros, u8)>,
+    /// The last format 0 image carried a valid stamp (PSX-LED-006).
+    pub(super) stamp_streaming: bool,
+    /// When the last time stamp fired (PSX-LED-005).
+    pub(super) stamp_fired_at: Option<Micros>,
     pub(super) last_cmd: Command,
     pub(super) armed: bool,
     pub(super) pending_transfer: bool,
@@ -197,6 +215,7 @@ impl<'s> Drive<'s> {
             core,
             order,
             values: BTreeMap::new(),
+            hot: Hot::default(),
             texts: BTreeMap::new(),
             saved: BTreeMap::new(),
             identity,
@@ -207,6 +226,8 @@ impl<'s> Drive<'s> {
             transfer_pulse: false,
             stamp: None,
             stamp_due: None,
+            stamp_streaming: false,
+            stamp_fired_at: None,
             last_cmd: Command::default(),
             armed: false,
             pending_transfer: false,
@@ -333,6 +354,48 @@ impl<'s> Drive<'s> {
         w
     }
 
+    /// What the three LEDs show now (manual 2.6, 3.3.1); all dark while the drive is off.
+    pub fn leds(&self) -> Leds {
+        if !self.core.powered() {
+            return Leds {
+                green: LedLight::Off,
+                orange: LedLight::Off,
+                yellow: LedLight::Off,
+            };
+        }
+        // PSX-LED-001, PSX-LED-002.
+        let green = if self.link_up {
+            LedLight::On90Percent
+        } else {
+            LedLight::Off
+        };
+        // PSX-LED-003: lit in the time-stamp format, dark in formats 1 and 2; PSX-LED-005: a
+        // fired stamp is acknowledged by a dark phase; PSX-LED-006: dark while valid stamps
+        // keep arriving.
+        let acknowledging = self
+            .stamp_fired_at
+            .is_some_and(|t| self.clock < t.saturating_add(self.fam.stamp_ack_dark_us));
+        let orange = if self.active_format == self.rules.timestamp().format
+            && !acknowledging
+            && !(self.link_up && self.stamp_streaming)
+        {
+            LedLight::On
+        } else {
+            LedLight::Off
+        };
+        // PSX-LED-004.
+        let yellow = if self.core.environment().motor_dv > 0 {
+            LedLight::On
+        } else {
+            LedLight::Off
+        };
+        Leds {
+            green,
+            orange,
+            yellow,
+        }
+    }
+
     /// Whether a status flag of the core is set (manual 3.4).
     pub fn flag(&self, flag: Flag) -> bool {
         self.core.flags().get(flag)
@@ -388,9 +451,9 @@ impl<'s> Drive<'s> {
         }
         Input {
             status: self.status_word(),
+            // PSX-ERRATUM-011: the input's speed is ISDU 65 (3.3.2).
             rpm: i16::try_from(
-                self.core
-                    .speed_rpm()
+                self.reported_rpm(self.core.speed_rpm())
                     .clamp(i64::from(i16::MIN), i64::from(i16::MAX)),
             )
             .unwrap_or(0),
@@ -480,8 +543,35 @@ impl<'s> Drive<'s> {
     /// A process output image in the active format received at `now` (manual 3.3.1); an
     /// input image answers it.
     pub fn handle_image(&mut self, now: Micros, bytes: &[u8]) -> Result<(), ImageError> {
-        let out = Output::parse(&self.rules, self.active_format, self.order, bytes)?;
+        let out = match self.high_bit_stamp_word(bytes) {
+            Some(moved) => Output::parse(&self.rules, self.active_format, self.order, &moved)?,
+            None => Output::parse(&self.rules, self.active_format, self.order, bytes)?,
+        };
         self.handle_output(now, &out)
+    }
+
+    /// The time-stamp image with its sub-word fields moved to the spec's bit positions when
+    /// the bits are numbered from the first transmitted bit (PSX-ERRATUM-051 reading
+    /// "high-bits": control code in the two most significant bits, stamp in the low 14;
+    /// PSX-PD-002). None when the image is taken as it is.
+    fn high_bit_stamp_word(&self, bytes: &[u8]) -> Option<Vec<u8>> {
+        if !self.fam.options.stamp_high_bits || self.active_format != self.rules.timestamp().format
+        {
+            return None;
+        }
+        let layout = &self.rules.output(self.active_format)?.layout;
+        let wire = layout.wire_order();
+        let mut moved = bytes.to_vec();
+        for f in layout.fields().iter().filter(|f| f.is_sub_word()) {
+            let word = f.read_word(bytes, self.order, wire)?;
+            let width = u32::try_from(f.len().saturating_mul(8)).ok()?;
+            let from = width.checked_sub(f.bit())?.checked_sub(f.bits())?;
+            let mask = 1u64.checked_shl(f.bits()).map_or(u64::MAX, |m| m - 1);
+            let value = word.checked_shr(from).unwrap_or(0) & mask;
+            f.write(&mut moved, self.order, wire, i64::try_from(value).ok()?)
+                .ok()?;
+        }
+        Some(moved)
     }
 
     /// A typed process output received at `now` (manual 3.3.1). An output of another format
@@ -596,6 +686,8 @@ impl<'s> Drive<'s> {
         self.transfer_pulse = false;
         self.stamp = None;
         self.stamp_due = None;
+        self.stamp_streaming = false;
+        self.stamp_fired_at = None;
         self.last_cmd = Command::default();
         self.armed = false;
         self.pending_transfer = false;

@@ -119,6 +119,8 @@ pub(crate) struct Ids {
     pub brake_start: Option<String>,
     pub brake_end: Option<String>,
     pub locks: String,
+    /// Idle period for direction change ISDU 162 (PSX-ISDU-162-REVERSE).
+    pub reversal_pause: String,
 }
 
 /// Masks of the control word bits (manual 3.5).
@@ -173,6 +175,13 @@ pub(crate) struct Options {
     pub pd_out_fixed: bool,
     /// PSX-ERRATUM-054: control code 3 stands for release only.
     pub code3_release_only: bool,
+    /// PSX-ERRATUM-056: ISDU 127 holds physical − written (user = physical − ISDU 127).
+    pub reference_negated: bool,
+    /// PSX-ERRATUM-011: ISDU 65 and 72 (and the input image's speed) are unsigned.
+    pub measurements_unsigned: bool,
+    /// PSX-ERRATUM-051: the control code sits in the two most significant bits of the
+    /// time-stamp word, the stamp in the low 14.
+    pub stamp_high_bits: bool,
 }
 
 /// How a reserved stamp value is taken (PSX-ERRATUM-061).
@@ -238,6 +247,9 @@ pub(crate) struct PsxFamily {
     pub loop_turns: [i64; 2],
     /// Software version from which format 2 and control bit 14 exist (1.6).
     pub format2_software: i64,
+    /// The dark phase of the orange LED that acknowledges a fired time stamp, µs (3.3.1,
+    /// the spec's `dark-<n>ms` pattern; PSX-LED-005).
+    pub stamp_ack_dark_us: u64,
 }
 
 fn spec_err(what: impl Into<String>) -> ModelError {
@@ -327,6 +339,10 @@ impl PsxFamily {
             product_id_series: reading("psx-product-id", "series") == "series",
             pd_out_fixed: reading("psx-pd-out-length", "format-dependent") == "fixed-16",
             code3_release_only: reading("psx-ts-code3", "release-and-transfer") == "release-only",
+            reference_negated: reading("psx-ref-sign", "written-minus-physical")
+                == "physical-minus-written",
+            measurements_unsigned: reading("psx-signed-measurements", "signed") == "unsigned",
+            stamp_high_bits: reading("psx-ts-bit-layout", "low-bits") == "high-bits",
         };
 
         let brake = match config.brake {
@@ -370,6 +386,7 @@ impl PsxFamily {
             brake_start: snap.and_then(|b| b.start_wait_param.clone()),
             brake_end: snap.and_then(|b| b.end_wait_param.clone()),
             locks: by_name(family, "Device access locks")?.to_owned(),
+            reversal_pause: by_name(family, "Idle period for direction change")?.to_owned(),
         };
 
         let roles = roles(family, p)?;
@@ -628,6 +645,7 @@ impl PsxFamily {
             encoder_span: i64::from(c.encoder_revolutions) * i64::from(mp.scaling_base),
             loop_turns: [i64::from(turn_n), i64::from(turn_d)],
             format2_software: i64::from(c.format2_min_software),
+            stamp_ack_dark_us: stamp_ack_dark_us(p)?,
         })
     }
 
@@ -647,6 +665,22 @@ impl PsxFamily {
     pub fn series(&self) -> String {
         self.model_id.chars().take(3).collect()
     }
+}
+
+/// The acknowledge dark phase of the orange LED from its `dark-<n>ms` pattern (3.3.1).
+fn stamp_ack_dark_us(p: &Protocol) -> Result<u64, ModelError> {
+    p.leds
+        .iter()
+        .filter(|l| l.colour == "orange")
+        .flat_map(|l| &l.states)
+        .find_map(|s| {
+            s.pattern
+                .strip_prefix("dark-")
+                .and_then(|ms| ms.strip_suffix("ms"))
+                .and_then(|ms| ms.parse::<u64>().ok())
+        })
+        .map(|ms| ms.saturating_mul(1000))
+        .ok_or_else(|| spec_err("no dark-<n>ms state of the orange LED"))
 }
 
 fn filter_id(family: &Family) -> Result<String, ModelError> {

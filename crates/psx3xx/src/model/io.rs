@@ -18,6 +18,40 @@ pub enum LinkEvent {
     Lost,
 }
 
+/// What one LED shows (manual 2.6; spec `[[protocol.led.state]]` patterns).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LedLight {
+    /// Dark (`off`, `dark`, `dark-250ms`).
+    Off,
+    /// Lit (`on`).
+    On,
+    /// Lit 90 % of the time, dark 10 % (`on-90-percent`, the IO-Link RUN LED).
+    On90Percent,
+}
+
+impl LedLight {
+    /// The spec's pattern name of the light (`off`, `on`, `on-90-percent`) (manual 2.6).
+    pub fn pattern(self) -> &'static str {
+        match self {
+            LedLight::Off => "off",
+            LedLight::On => "on",
+            LedLight::On90Percent => "on-90-percent",
+        }
+    }
+}
+
+/// The three LEDs under the sealing plug (manual 2.6, 3.3.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub struct Leds {
+    /// Green IO-Link RUN LED (PSX-LED-001, PSX-LED-002).
+    pub green: LedLight,
+    /// Orange time-stamp LED (PSX-LED-003, PSX-LED-005, PSX-LED-006).
+    pub orange: LedLight,
+    /// Yellow motor-voltage LED (PSX-LED-004).
+    pub yellow: LedLight,
+}
+
 /// The state of the two jog key inputs (manual 2.5.3, 5.10).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize)]
 pub struct JogKeys {

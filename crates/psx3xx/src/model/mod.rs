@@ -17,7 +17,8 @@
 //! execution, the run-start rules of 5.3, the 8-byte format's speed rules and the CW/CCW speed
 //! caps, jog keys and jog bits, brakes, the drag error and its correction, the initial
 //! reference loop, the ISDU server with guard entries, ISDU 2 / 193 with the EEPROM image kept
-//! apart from the working values, and the three master time-out behaviours of 5.9. Every
+//! apart from the working values, the three master time-out behaviours of 5.9, the idle
+//! period before a reversal (ISDU 162) and the three LEDs of 2.6 ([`Drive::leds`]). Every
 //! number comes from the spec; erratum readings come from [`drivespec_spec::Readings`];
 //! decisions where the manual is silent are marked DECISION.
 //!
@@ -34,4 +35,4 @@ mod server;
 pub use config::{BrakeKind, DriveConfig};
 pub use drive::{Drive, MAX_QUEUED};
 pub use error::ModelError;
-pub use io::{Event, IsduAnswer, JogKeys, LinkEvent, RunState};
+pub use io::{Event, IsduAnswer, JogKeys, LedLight, Leds, LinkEvent, RunState};

@@ -40,6 +40,17 @@ impl<'s> Drive<'s> {
         }
     }
 
+    /// A core setting as ISDU shows it and back (the mapping is its own inverse): under
+    /// PSX-ERRATUM-056 reading "physical-minus-written" ISDU 127 holds physical − written,
+    /// the negative of the core's referencing value (written − physical) (PSX-POS-009).
+    fn isdu_view(&self, s: Setting, v: i64) -> i64 {
+        if s == Setting::Reference && self.fam.options.reference_negated {
+            v.saturating_neg()
+        } else {
+            v
+        }
+    }
+
     // ------------------------------------------------------------------ requests
 
     /// An ISDU request received at `now` (manual 3.1); the answer is queued for
@@ -250,6 +261,7 @@ impl<'s> Drive<'s> {
                 value,
             },
         );
+        self.refresh_hot();
         self.update_speeds();
         self.after_core(now);
         Ok(false)
@@ -290,7 +302,9 @@ impl<'s> Drive<'s> {
         let id = e.id.as_str();
         match e.role {
             Role::Core(Setting::MappingEnd) => {
-                // PSX-MAP-004: 1 + ref <= end <= 204800 x den/num - 1 + ref.
+                // PSX-MAP-004: 1 + ref <= end <= 204800 x den/num - 1 + ref, with ref the
+                // core's written − physical shift under either reading of PSX-ERRATUM-056
+                // (the bounds keep their physical place).
                 let ref_ = self.core.get(Setting::Reference);
                 let span = self.core.axis().scale(self.fam.mapping_span);
                 let (lo, hi) = (
@@ -332,6 +346,7 @@ impl<'s> Drive<'s> {
             }
             Role::Core(s) => {
                 // PSX-POS-005, PSX-POS-007, PSX-POS-008, PSX-POS-009, PSX-ISDU-131-SCALE.
+                let v = self.isdu_view(s, v);
                 self.core_set(now, s, v, ErrorCase::ValueOutOfRange, id)?;
                 self.snapshot();
             }
@@ -447,18 +462,18 @@ impl<'s> Drive<'s> {
     fn number(&self, e: &Entry) -> i64 {
         let env = self.core.environment();
         match e.role {
-            Role::Core(s) => self.core.get(s),
+            Role::Core(s) => self.isdu_view(s, self.core.get(s)),
             Role::LoopLength => self.core.get(Setting::LoopLength).abs(),
             Role::Filter | Role::LoopDirection | Role::Stored | Role::Format => self.val(&e.id),
             Role::Status => i64::from(self.status_word()),
-            // PSX-ISDU-65-UNIT.
-            Role::Rpm => self.core.speed_rpm(),
+            // PSX-ISDU-65-UNIT (PSX-ERRATUM-011).
+            Role::Rpm => self.reported_rpm(self.core.speed_rpm()),
             Role::Torque => self.torque_now(),
             Role::MaxTorque => self.max_torque,
             // PSX-ISDU-70-UNIT, PSX-ISDU-72-UNIT.
             Role::ControlVoltage => i64::from(env.control_dv),
             Role::MotorVoltage => self.core.motor_voltage(),
-            Role::Temperature => i64::from(env.celsius),
+            Role::Temperature => self.reported_celsius(i64::from(env.celsius)),
             Role::ProductionDate => self.identity.production_date,
             Role::SerialNumber => self.identity.serial_number,
             // PSX-ISDU-79-CODES.
@@ -471,6 +486,27 @@ impl<'s> Drive<'s> {
             Role::Command => 0,
             Role::Direct(address) => self.direct_byte(e, address),
             Role::Text(_) => 0,
+        }
+    }
+
+    /// ISDU 65 as the drive reports it (PSX-ISDU-65-UNIT): signed under the adopted reading
+    /// of PSX-ERRATUM-011; under "unsigned" by its magnitude (DECISION: an unsigned speed
+    /// carries no direction).
+    pub(super) fn reported_rpm(&self, rpm: i64) -> i64 {
+        if self.fam.options.measurements_unsigned {
+            rpm.saturating_abs()
+        } else {
+            rpm
+        }
+    }
+
+    /// ISDU 72 as the drive reports it (PSX-ISDU-72-UNIT): signed under the adopted reading
+    /// of PSX-ERRATUM-011; under "unsigned" a temperature below 0 °C reads 0 (DECISION).
+    fn reported_celsius(&self, celsius: i64) -> i64 {
+        if self.fam.options.measurements_unsigned {
+            celsius.max(0)
+        } else {
+            celsius
         }
     }
 
@@ -531,7 +567,7 @@ impl<'s> Drive<'s> {
             };
             let Some(v) = v else { continue };
             match e.role {
-                Role::Core(s) => settings.put(s, v),
+                Role::Core(s) => settings.put(s, self.isdu_view(s, v)),
                 Role::LoopLength => settings.put(Setting::LoopLength, v),
                 Role::Filter | Role::LoopDirection | Role::Stored | Role::Format => {
                     self.values.insert(e.id.clone(), v);
@@ -539,6 +575,7 @@ impl<'s> Drive<'s> {
                 _ => {}
             }
         }
+        self.refresh_hot();
         let sign = self.loop_sign();
         settings.axis.loop_length = settings.axis.loop_length.abs() * sign;
         let filter = fam
@@ -587,6 +624,7 @@ impl<'s> Drive<'s> {
         if keep_format {
             self.values.insert(fam.ids.format.clone(), format);
         }
+        self.refresh_hot();
         self.texts.clear();
         let mut settings = fam.factory;
         settings.axis.loop_length = settings.axis.loop_length.abs() * self.loop_sign();
