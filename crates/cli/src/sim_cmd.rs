@@ -2,6 +2,7 @@
 
 use crate::{Context, Outcome};
 use anyhow::{bail, Context as _, Result};
+use drivespec_conform::cyclic::Server;
 use drivespec_conform::serve::{self, DeviceOptions, Faults, Options, ServedDevice, Stats, Stop};
 use drivespec_spec::FamilyId;
 use std::io::Write;
@@ -13,7 +14,7 @@ use std::time::Duration;
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("transport").required(true).args(["listen", "pty", "stdio"])))]
 pub struct SimArgs {
-    /// Device family: hpd (psd4xx and psx3xx are not available yet).
+    /// Device family: hpd (serial protocol), psd4xx or psx3xx (cyclic-exchange protocol).
     device: String,
     /// Device model, matched forgivingly.
     #[arg(long)]
@@ -36,9 +37,12 @@ pub struct SimArgs {
     /// Probability (0–1) that an answer is not sent.
     #[arg(long, value_name = "P", default_value_t = 0.0)]
     drop_answers: f64,
-    /// Probability (0–1) that an answer with a checksum is sent with a wrong one.
+    /// Probability (0–1) that an answer with a checksum is sent with a wrong one (hpd).
     #[arg(long, value_name = "P", default_value_t = 0.0)]
     corrupt_checksums: f64,
+    /// Probability (0–1) that an input image is sent with one bit flipped (psd4xx, psx3xx).
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    corrupt_images: f64,
     /// Extra delay of every answer, in ms.
     #[arg(long, value_name = "D", default_value_t = 0.0)]
     delay_ms: f64,
@@ -59,10 +63,7 @@ pub struct SimArgs {
 /// Runs `drivespec sim`.
 pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
     let Some(family) = FamilyId::parse(&args.device) else {
-        bail!(
-            "unknown device {:?}: hpd (psd4xx and psx3xx are not available yet)",
-            args.device
-        );
+        bail!("unknown device {:?}: hpd, psd4xx or psx3xx", args.device);
     };
     if !(args.delay_ms.is_finite() && args.delay_ms >= 0.0) {
         bail!("--delay-ms {}: a time in ms, 0 or more", args.delay_ms);
@@ -77,10 +78,17 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
     let faults = Faults {
         drop_answers: args.drop_answers,
         corrupt_checksums: args.corrupt_checksums,
+        corrupt_images: args.corrupt_images,
         delay_us: (args.delay_ms * 1000.0).round() as u64,
         seed: args.seed,
     };
     faults.check()?;
+    if family != FamilyId::Hpd {
+        return run_cyclic(&args, ctx, family, faults, time_limit);
+    }
+    if args.corrupt_images > 0.0 {
+        bail!("--corrupt-images is for the cyclic-exchange families (psd4xx, psx3xx); hpd takes --corrupt-checksums");
+    }
     let spec = Arc::new(ctx.spec()?);
     let device = serve::device(
         spec,
@@ -134,6 +142,124 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
     };
     print_stats(&mut log, &stats);
     Ok(Outcome::Pass)
+}
+
+/// `drivespec sim psd4xx|psx3xx`: the family's cyclic server on tcp, a pty or stdio.
+fn run_cyclic(
+    args: &SimArgs,
+    ctx: &Context,
+    family: FamilyId,
+    faults: Faults,
+    time_limit: Option<Duration>,
+) -> Result<Outcome> {
+    if args.corrupt_checksums > 0.0 {
+        bail!("--corrupt-checksums is for hpd; the cyclic-exchange protocol has no checksums (use --corrupt-images)");
+    }
+    if args.baud_code.is_some() || args.addr != 0 || args.any_bit_rate {
+        bail!("--baud-code, --addr and --any-bit-rate are for hpd (serial line)");
+    }
+    let spec = ctx.spec()?;
+    let opts = Options {
+        faults,
+        log: args.log,
+        time_limit,
+        max_clients: None,
+        check_bit_rate: false,
+    };
+    serve::with_cyclic_server(&spec, family, args.model.as_deref(), |server, name| {
+        serve_cyclic(args, family, server, name, &opts)
+    })?
+}
+
+/// Serves `server` on the transport `args` names until stopped.
+fn serve_cyclic(
+    args: &SimArgs,
+    family: FamilyId,
+    server: &mut Server<'_>,
+    name: &str,
+    opts: &Options,
+) -> Result<Outcome> {
+    let faults = opts.faults;
+    let stop = Stop::new();
+    let stderr = std::io::stderr();
+    let mut log = stderr.lock();
+    let banner = |log: &mut dyn Write, on: &str| {
+        let _ = writeln!(
+            log,
+            "drivespec sim: {name} on {on} (drivespec-cyclic/1); {}",
+            faults.describe()
+        );
+    };
+    let stats = if let Some(listen) = &args.listen {
+        let Some(addr) = listen.strip_prefix("tcp:") else {
+            bail!("--listen {listen:?}: expected tcp:HOST:PORT (e.g. tcp:127.0.0.1:4000)");
+        };
+        let listener =
+            TcpListener::bind(addr).with_context(|| format!("cannot listen on tcp:{addr}"))?;
+        let local = listener
+            .local_addr()
+            .with_context(|| format!("cannot listen on tcp:{addr}"))?;
+        print_line(&local.to_string());
+        banner(&mut log, &format!("tcp:{local}"));
+        let _ = writeln!(
+            log,
+            "drivespec sim: test it with: drivespec conform {family} --dut tcp:{local}"
+        );
+        serve::serve_cyclic_tcp(listener, server, opts, &stop, &mut log)?
+    } else if args.pty {
+        serve_cyclic_pty(server, opts, &stop, &mut log, family, banner)?
+    } else {
+        banner(&mut log, "stdin/stdout");
+        serve::serve_cyclic_stdio(server, opts, &stop, &mut log)?
+    };
+    let _ = writeln!(
+        log,
+        "drivespec sim: served {:.1} s{}: {} byte(s) received, {} reply line(s) sent, {} dropped, {} image(s) corrupted, {} lost",
+        stats.wall_us as f64 / 1e6,
+        if stats.clients > 0 {
+            format!(", {} client(s)", stats.clients)
+        } else {
+            String::new()
+        },
+        stats.received,
+        stats.sent,
+        stats.dropped,
+        stats.corrupted,
+        stats.lost
+    );
+    Ok(Outcome::Pass)
+}
+
+#[cfg(unix)]
+fn serve_cyclic_pty(
+    server: &mut Server<'_>,
+    opts: &Options,
+    stop: &Stop,
+    log: &mut dyn Write,
+    family: FamilyId,
+    banner: impl Fn(&mut dyn Write, &str),
+) -> Result<Stats> {
+    let pty = serve::Pty::open(None)?;
+    print_line(pty.path());
+    banner(log, pty.path());
+    let _ = writeln!(
+        log,
+        "drivespec sim: test it with: drivespec conform {family} --dut serial:{}",
+        pty.path()
+    );
+    Ok(serve::serve_cyclic_pty(&pty, server, opts, stop, log)?)
+}
+
+#[cfg(not(unix))]
+fn serve_cyclic_pty(
+    _server: &mut Server<'_>,
+    _opts: &Options,
+    _stop: &Stop,
+    _log: &mut dyn Write,
+    _family: FamilyId,
+    _banner: impl Fn(&mut dyn Write, &str),
+) -> Result<Stats> {
+    bail!("--pty needs a Unix system (pseudo-terminals); use --listen or --stdio")
 }
 
 #[cfg(unix)]

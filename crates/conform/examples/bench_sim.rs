@@ -3,13 +3,16 @@
 //!
 //! 1. the full HPD suite against the built-in model (`--dut sim`, virtual time): wall time,
 //!    cases/s and simulated time per wall second, reports written;
-//! 2. the full HPD suite against the served model on a pseudo-terminal (`drivespec sim hpd
+//! 2. the full PSx3xx suite against the built-in model on virtual time, on the default model
+//!    (reports written) and on every model of the spec;
+//! 3. the full HPD suite against the served model on a pseudo-terminal (`drivespec sim hpd
 //!    --pty` in-process, `--dut serial:`): real time;
-//! 3. the serial transport: the runner's own time per exchange over a pty next to the line
+//! 4. the serial transport: the runner's own time per exchange over a pty next to the line
 //!    time the same bytes need at each Pr26 bit rate (bytes × 11 bits / baud) plus the drive's
 //!    answer delay. The runner's time is each answered exchange's step time from the report
 //!    minus a raw round trip (the same request written and the answer read straight on the
-//!    port: the pty and the served model).
+//!    port: the pty and the served model);
+//! 5. the same exchanges over TCP on loopback.
 //!
 //! Run: `cargo run --release -p drivespec-conform --example bench_sim [-- REPEATS]`.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
@@ -24,7 +27,23 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 fn conform(spec: &Spec, dut: Dut, cases: &[&str], reports: Option<&std::path::Path>) -> Summary {
+    conform_family(spec, FamilyId::Hpd, None, dut, cases, reports)
+}
+
+fn conform_family(
+    spec: &Spec,
+    family: FamilyId,
+    model: Option<&str>,
+    dut: Dut,
+    cases: &[&str],
+    reports: Option<&std::path::Path>,
+) -> Summary {
     let opts = drivespec_conform::Options {
+        families: vec![family],
+        settings: drivespec_conform::suite::Settings {
+            model: model.map(str::to_owned),
+            ..drivespec_conform::suite::Settings::default()
+        },
         dut,
         case: cases.iter().map(|s| (*s).to_owned()).collect(),
         progress: Progress::Quiet,
@@ -106,7 +125,61 @@ fn main() {
     );
     println!("    ({}; median of {repeats})", count(&s));
 
-    // 2. The full suite against the served model on a pty, real time.
+    // 2. The PSx3xx suite on virtual time: the default model with reports, then every model.
+    let mut walls = Vec::new();
+    let mut last = None;
+    for _ in 0..repeats {
+        let t = Instant::now();
+        let s = conform_family(
+            &spec,
+            FamilyId::Psx3xx,
+            None,
+            Dut::default(),
+            &[],
+            Some(&dir),
+        );
+        walls.push(t.elapsed().as_secs_f64());
+        last = Some(s);
+    }
+    let s = last.unwrap();
+    let wall = median(&mut walls);
+    let simulated: u64 = s.report.cases.iter().map(|c| c.elapsed_us).sum();
+    println!(
+        "| `drivespec conform psx3xx` against `--dut sim` (virtual time, {}), {} cases, reports written | {:.0} ms, {:.0} cases/s, {:.0} s simulated per wall second ({:.1} s simulated) | `cargo run --release -p drivespec-conform --example bench_sim` |",
+        s.report
+            .run
+            .model
+            .clone()
+            .unwrap_or_else(|| drivespec_conform::psx3xx::DEFAULT_MODEL.to_owned()),
+        s.report.summary.total,
+        wall * 1e3,
+        s.report.summary.total as f64 / wall,
+        simulated as f64 / 1e6 / wall,
+        simulated as f64 / 1e6
+    );
+    println!("    ({}; median of {repeats})", count(&s));
+    let models: Vec<String> = spec
+        .family(FamilyId::Psx3xx)
+        .models
+        .iter()
+        .map(|m| m.id.clone())
+        .collect();
+    let t = Instant::now();
+    let (mut total, mut failed) = (0, 0);
+    for m in &models {
+        let s = conform_family(&spec, FamilyId::Psx3xx, Some(m), Dut::default(), &[], None);
+        total += s.report.summary.total;
+        failed += s.report.summary.failed;
+    }
+    let wall = t.elapsed().as_secs_f64();
+    println!(
+        "| `drivespec conform psx3xx --model M` for each of the {} models, no reports | {:.1} s, {:.0} cases/s ({total} cases, {failed} failed) | same |",
+        models.len(),
+        wall,
+        total as f64 / wall
+    );
+
+    // 3. The full HPD suite against the served model on a pty, real time.
     let dev = serve::device(spec.clone(), FamilyId::Hpd, &DeviceOptions::default()).unwrap();
     let pty = serve::Pty::open(dev.bit_rate()).unwrap();
     let path = pty.path().to_owned();
@@ -143,7 +216,7 @@ fn main() {
     );
     println!("    ({}; failed: {failed:?})", count(&full));
 
-    // 3a. Raw round trips on the same pty: read Pr33 (5 bytes) and its answer (7 bytes).
+    // 4a. Raw round trips on the same pty: read Pr33 (5 bytes) and its answer (7 bytes).
     let mut port = serialport::new(&path, 57_600)
         .parity(serialport::Parity::Even)
         .timeout(Duration::from_millis(100))
@@ -165,7 +238,7 @@ fn main() {
     drop(port);
     let raw_us = median(&mut raw);
 
-    // 3b. The runner's answered exchanges: every parameter case (reads, writes, edges).
+    // 4b. The runner's answered exchanges: every parameter case (reads, writes, edges).
     let (n, step_us, bytes) = exchanges(&spec, &dut, repeats.min(3));
     let own = (step_us - raw_us).max(0.0);
     stop.stop();
@@ -202,7 +275,7 @@ fn main() {
         stats.sent
     );
 
-    // 4. The same exchanges over TCP on loopback (`drivespec sim hpd --listen`).
+    // 5. The same exchanges over TCP on loopback (`drivespec sim hpd --listen`).
     let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = listener.local_addr().unwrap();
     let dev = serve::device(spec.clone(), FamilyId::Hpd, &DeviceOptions::default()).unwrap();

@@ -3,7 +3,8 @@
 //! the device, and reports (JUnit XML, JSON, self-contained HTML).
 //!
 //! - [`suite`]: the [`suite::Suite`]/[`suite::Session`] traits a family implements; HPD in
-//!   [`hpd`].
+//!   [`hpd`], PSD4xx in [`psd4xx`], PSx3xx in [`psx3xx`] (the last two over the
+//!   cyclic-exchange protocol of [`cyclic`]).
 //! - [`link`]: the transports (`sim`, `serial`, `tcp`, `exec`) behind [`link::Link`].
 //! - [`runner`]: selection, expectations, progress, reports; [`runner::run`] is what the CLI
 //!   calls.
@@ -18,7 +19,9 @@ pub mod dut;
 pub mod fuzz;
 pub mod hpd;
 pub mod link;
+pub mod plot;
 pub mod psd4xx;
+pub mod psx3xx;
 pub mod report;
 mod rng;
 pub mod runner;

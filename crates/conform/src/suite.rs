@@ -3,8 +3,9 @@
 //! A family plugs in by implementing [`Suite`] (the case list, opening a session on a
 //! `--dut`) and [`Session`] (running one case against the device and the family's reference
 //! model). The runner, selection, expectations and reports are shared. HPD is implemented in
-//! [`crate::hpd`]; PSD4xx and PSx3xx join with their own reference models and a cyclic
-//! exchange over the same [`crate::link::Link`] transports.
+//! [`crate::hpd`]; PSD4xx ([`crate::psd4xx`]) and PSx3xx ([`crate::psx3xx`]) run their
+//! reference models over the cyclic exchange of [`crate::cyclic`] on the same
+//! [`crate::link::Link`] transports.
 
 use crate::case::{CaseInfo, CaseRun};
 use crate::dut::Dut;
@@ -74,6 +75,6 @@ pub fn suite<'s>(
     match family {
         FamilyId::Hpd => Ok(Box::new(crate::hpd::HpdSuite::new(spec, settings)?)),
         FamilyId::Psd4xx => Ok(Box::new(crate::psd4xx::Psd4xxSuite::new(spec, settings)?)),
-        other => Err(SetupError::NoSuite(other)),
+        FamilyId::Psx3xx => Ok(Box::new(crate::psx3xx::Psx3xxSuite::new(spec, settings)?)),
     }
 }

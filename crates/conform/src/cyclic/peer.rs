@@ -44,14 +44,14 @@ pub trait Peer: Send {
 }
 
 /// The device side in the same process: lines go straight to a [`Server`].
-pub struct LocalPeer {
+pub struct LocalPeer<'s> {
     name: String,
-    server: Server,
+    server: Server<'s>,
 }
 
-impl LocalPeer {
+impl<'s> LocalPeer<'s> {
     /// A peer on `server`, described as `name`.
-    pub fn new(name: &str, server: Server) -> LocalPeer {
+    pub fn new(name: &str, server: Server<'s>) -> LocalPeer<'s> {
         LocalPeer {
             name: name.to_owned(),
             server,
@@ -59,7 +59,7 @@ impl LocalPeer {
     }
 }
 
-impl Peer for LocalPeer {
+impl Peer for LocalPeer<'_> {
     fn describe(&self) -> String {
         self.name.clone()
     }

@@ -1,34 +1,68 @@
-//! The device side of `drivespec-cyclic/1` for a sans-IO model: the built-in PSD4xx reference
-//! drive, or a test wrapper around it with a planted deviation.
+//! The device side of `drivespec-cyclic/1` for a sans-IO model: the built-in PSD4xx or PSx3xx
+//! reference drive, or a test wrapper around one with a planted deviation.
 //!
 //! [`Server::handle_line`] turns one request line into one reply line; [`Server::serve`] runs
 //! that loop over any reader and writer (a TCP stream, stdin/stdout). Times are µs since the
 //! last `RESET`; an earlier time than the last one counts as now (the model never goes back).
+//! A server borrows what its device borrows (the PSx3xx drive borrows the spec: `Server<'s>`);
+//! the PSD4xx drive owns everything (`Server<'static>`).
 
 use super::wire::{Env, Reply, Request, VERSION};
 use drivespec_positioner::{EnvChange, Micros};
 use drivespec_psd4xx::model::{Drive, RecordAnswer, RecordFailure, RecordRequest};
+use drivespec_psx3xx::isdu::{Request as IsduRequest, Response};
+use drivespec_psx3xx::model::{Drive as PsxDrive, JogKeys, LinkEvent as PsxLink};
+use drivespec_spec::FamilyId;
 use std::io::{BufRead, Write};
 
 /// A device model the server drives.
-pub trait CyclicDevice: Send {
+pub trait CyclicDevice<'s>: Send {
     /// One output image at `now`; the input image that answers it.
     fn cycle(&mut self, now: Micros, image: &[u8]) -> Result<Vec<u8>, String>;
     /// Lets time pass until `now`.
     fn advance(&mut self, now: Micros);
-    /// An acyclic record at `now`; None when the device does not answer.
+    /// A PSD4xx acyclic record at `now` (3.2.2); None when the device does not answer.
+    /// Devices without records keep the default, which never answers.
     fn record(
         &mut self,
         now: Micros,
         req: RecordRequest,
-    ) -> Option<Result<RecordAnswer, RecordFailure>>;
+    ) -> Option<Result<RecordAnswer, RecordFailure>> {
+        let _ = (now, req);
+        None
+    }
+    /// A PSx3xx ISDU request at `now` (3.1): `DATA`, `WRITTEN`, `ISDU-ERROR NAME` or
+    /// `SILENT`. Devices without ISDU access keep the default, an `ERR` reply.
+    fn isdu(&mut self, now: Micros, req: IsduRequest) -> Reply {
+        let _ = (now, req);
+        Reply::Err("no ISDU access on this device".to_owned())
+    }
     /// An environment injection at `now`; false when not supported.
     fn env(&mut self, now: Micros, env: Env) -> bool;
     /// A copy in the same state.
-    fn clone_box(&self) -> Box<dyn CyclicDevice>;
+    fn clone_box(&self) -> Box<dyn CyclicDevice<'s> + 's>;
 }
 
-impl CyclicDevice for Drive {
+/// The positioning-core change an injection names; None for `power-cycle`, `link` and
+/// `keys`, which each family handles itself.
+pub fn env_change(env: Env) -> Option<EnvChange> {
+    Some(match env {
+        Env::Jam(on) => EnvChange::Jam { on },
+        Env::Displace(by) => EnvChange::Displace { by },
+        Env::MotorVoltage(dv) => EnvChange::MotorVoltage { dv },
+        Env::MissSteps(by) => EnvChange::MissSteps { by },
+        Env::Temperature(celsius) => EnvChange::Temperature { celsius },
+        Env::ControlVoltage(dv) => EnvChange::ControlVoltage { dv },
+        Env::LoadTorque(cnm) => EnvChange::LoadTorque { cnm },
+        Env::BackDrive(rpm) => EnvChange::BackDrive { rpm },
+        Env::Block(at) => EnvChange::Block { at },
+        Env::ClearBlocks => EnvChange::ClearBlocks,
+        Env::PositionFault => EnvChange::PositionFault,
+        Env::PowerCycle | Env::Link(_) | Env::Keys { .. } => return None,
+    })
+}
+
+impl CyclicDevice<'static> for Drive {
     fn cycle(&mut self, now: Micros, image: &[u8]) -> Result<Vec<u8>, String> {
         self.handle_image(now, image).map_err(|e| e.to_string())?;
         let mut last = None;
@@ -62,40 +96,114 @@ impl CyclicDevice for Drive {
     fn env(&mut self, now: Micros, env: Env) -> bool {
         match env {
             Env::PowerCycle => self.power_cycle(now),
-            Env::Jam(on) => self.handle_env(now, EnvChange::Jam { on }),
-            Env::Displace(by) => self.handle_env(now, EnvChange::Displace { by }),
-            Env::MotorVoltage(dv) => self.handle_env(now, EnvChange::MotorVoltage { dv }),
-            Env::MissSteps(by) => self.handle_env(now, EnvChange::MissSteps { by }),
-            Env::Temperature(celsius) => self.handle_env(now, EnvChange::Temperature { celsius }),
             Env::Link(e) => self.handle_link(now, e),
+            Env::Keys { .. } => return false,
+            other => match env_change(other) {
+                Some(change) => self.handle_env(now, change),
+                None => return false,
+            },
         }
         while self.poll_event().is_some() {}
         true
     }
 
-    fn clone_box(&self) -> Box<dyn CyclicDevice> {
+    fn clone_box(&self) -> Box<dyn CyclicDevice<'static> + 'static> {
+        Box::new(self.clone())
+    }
+}
+
+/// The ErrorType of an ISDU refusal as the wire names it: the spec's name, else hex.
+fn isdu_reply(drive: &PsxDrive<'_>, response: Response) -> Reply {
+    match response {
+        Response::Read { data } => Reply::Data(data),
+        Response::Write => Reply::Written,
+        Response::Error { error } => {
+            Reply::IsduError(drive.rules().error_types().named(error).to_string())
+        }
+    }
+}
+
+impl<'s> CyclicDevice<'s> for PsxDrive<'s> {
+    fn cycle(&mut self, now: Micros, image: &[u8]) -> Result<Vec<u8>, String> {
+        self.handle_image(now, image).map_err(|e| e.to_string())?;
+        let mut last = None;
+        while let Some((_, input)) = self.poll_input() {
+            last = Some(input);
+        }
+        match last {
+            Some(i) => i
+                .to_bytes(self.rules(), self.byte_order())
+                .map_err(|e| e.to_string()),
+            // Switched off or not communicating: the image the drive holds.
+            None => Ok(self.input_image()),
+        }
+    }
+
+    fn advance(&mut self, now: Micros) {
+        PsxDrive::advance(self, now);
+    }
+
+    fn isdu(&mut self, now: Micros, req: IsduRequest) -> Reply {
+        self.handle_isdu(now, req);
+        let mut last = None;
+        while let Some(a) = self.poll_isdu() {
+            last = Some(a.response);
+        }
+        match last {
+            Some(r) => isdu_reply(self, r),
+            None => Reply::Silent,
+        }
+    }
+
+    fn env(&mut self, now: Micros, env: Env) -> bool {
+        match env {
+            Env::PowerCycle => self.power_cycle(now),
+            Env::Link(e) => match e {
+                drivespec_psd4xx::model::LinkEvent::Lost => self.handle_link(now, PsxLink::Lost),
+                drivespec_psd4xx::model::LinkEvent::Connected => {
+                    self.handle_link(now, PsxLink::Connected)
+                }
+                // IOPS is PROFINET's; IO-Link has no such state.
+                _ => return false,
+            },
+            Env::Keys { forward, reverse } => self.handle_keys(now, JogKeys { forward, reverse }),
+            other => match env_change(other) {
+                Some(change) => self.handle_env(now, change),
+                None => return false,
+            },
+        }
+        while self.poll_event().is_some() {}
+        true
+    }
+
+    fn clone_box(&self) -> Box<dyn CyclicDevice<'s> + 's> {
         Box::new(self.clone())
     }
 }
 
 /// Serves one device over `drivespec-cyclic/1`.
-pub struct Server {
+pub struct Server<'s> {
     name: String,
     family: String,
-    start: Box<dyn CyclicDevice>,
-    device: Box<dyn CyclicDevice>,
+    start: Box<dyn CyclicDevice<'s> + 's>,
+    device: Box<dyn CyclicDevice<'s> + 's>,
 }
 
-impl Server {
+impl<'s> Server<'s> {
     /// A server for `device` (its state now is what `RESET` restores), of `family`, named
     /// `name` in its `HELLO`.
-    pub fn new(name: &str, family: &str, device: Box<dyn CyclicDevice>) -> Server {
+    pub fn new(name: &str, family: &str, device: Box<dyn CyclicDevice<'s> + 's>) -> Server<'s> {
         Server {
             name: name.to_owned(),
             family: family.to_owned(),
             start: device.clone_box(),
             device,
         }
+    }
+
+    /// Whether the family served speaks ISDU (PSx3xx) rather than records (PSD4xx).
+    fn isdu_family(&self) -> bool {
+        self.family == FamilyId::Psx3xx.as_str()
     }
 
     /// Answers one request.
@@ -127,12 +235,34 @@ impl Server {
                 self.device.advance(t);
                 Reply::Ok
             }
+            Request::Read { .. } | Request::Write { .. } if self.isdu_family() => {
+                Reply::Err("records are PSD4xx requests; PSx3xx uses ISDU-READ/ISDU-WRITE".into())
+            }
+            Request::IsduRead { .. } | Request::IsduWrite { .. } if !self.isdu_family() => {
+                Reply::Err(format!("no ISDU access on {}; use READ/WRITE", self.family))
+            }
             Request::Read { t, index } => {
                 record_reply(self.device.record(t, RecordRequest::Read { index }))
             }
             Request::Write { t, index, data } => {
                 record_reply(self.device.record(t, RecordRequest::Write { index, data }))
             }
+            Request::IsduRead { t, index, subindex } => {
+                self.device.isdu(t, IsduRequest::Read { index, subindex })
+            }
+            Request::IsduWrite {
+                t,
+                index,
+                subindex,
+                data,
+            } => self.device.isdu(
+                t,
+                IsduRequest::Write {
+                    index,
+                    subindex,
+                    data,
+                },
+            ),
             Request::Env { t, env } => {
                 if self.device.env(t, env) {
                     Reply::Ok
@@ -172,5 +302,55 @@ fn record_reply(r: Option<Result<RecordAnswer, RecordFailure>>) -> Reply {
         Some(Ok(RecordAnswer::Ignored)) => Reply::Ignored,
         Some(Err(RecordFailure::Malformed { .. })) => Reply::Malformed,
         Some(Err(RecordFailure::Refused { error })) => Reply::Refused(error.0),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::suite::Settings;
+    use drivespec_spec::Spec;
+
+    #[test]
+    fn a_psx3xx_server_answers_isdu_and_refuses_records() {
+        let spec = Spec::builtin().unwrap_or_else(|e| panic!("{e:?}"));
+        let suite = crate::psx3xx::Psx3xxSuite::new(&spec, &Settings::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut s = suite.server();
+        let mut ask = |line: &str| s.handle_line(line);
+        assert_eq!(
+            ask("HELLO drivespec-cyclic 1 psx3xx PSE312-8"),
+            "HELLO drivespec-cyclic 1 drivespec reference PSE312-8"
+        );
+        assert!(ask("HELLO drivespec-cyclic 1 psd4xx PSD401-5V").starts_with("ERR"));
+        assert_eq!(ask("RESET"), "OK");
+        assert_eq!(ask("ISDU-READ 0 1 0"), "ISDU-ERROR IDX_NOTAVAIL");
+        assert_eq!(ask("ISDU-READ 0 116 0"), "DATA 01");
+        assert_eq!(ask("ISDU-WRITE 0 116 0 -"), "ISDU-ERROR VAL_LENUNDRUN");
+        assert_eq!(ask("ISDU-WRITE 0 116 0 0102"), "ISDU-ERROR VAL_LENOVRRUN");
+        assert!(ask("READ 0 44").starts_with("ERR"));
+        assert_eq!(ask("ENV 0 keys forward"), "OK");
+        // Status bit 3 (forward key) in the input image; format 1 output of 6 bytes.
+        assert_eq!(ask("CYCLE 8000 000000000000"), "IN 011800000000C800");
+        assert!(ask("CYCLE 16000 00").starts_with("ERR"));
+        assert_eq!(ask("ENV 16000 link iops-bad"), "UNSUPPORTED");
+        assert_eq!(ask("ENV 16000 link lost"), "OK");
+        assert_eq!(ask("ISDU-READ 24000 116 0"), "SILENT");
+        assert_eq!(ask("ENV 24000 power-cycle 0"), "OK");
+        assert!(ask("ISDU-READ x").starts_with("ERR"));
+        assert_eq!(ask("RESET"), "OK");
+        assert_eq!(ask("ISDU-READ 0 116 0"), "DATA 01");
+    }
+
+    #[test]
+    fn a_psd4xx_server_refuses_isdu_and_keys() {
+        let spec = Spec::builtin().unwrap_or_else(|e| panic!("{e:?}"));
+        let suite = crate::psd4xx::Psd4xxSuite::new(&spec, &Settings::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut s = suite.server();
+        assert_eq!(s.handle_line("RESET"), "OK");
+        assert!(s.handle_line("ISDU-READ 0 116 0").starts_with("ERR"));
+        assert_eq!(s.handle_line("ENV 0 keys both"), "UNSUPPORTED");
+        assert_eq!(s.handle_line("ENV 0 control-voltage 240"), "OK");
+        assert!(s.handle_line("READ 0 44").starts_with("DATA"));
     }
 }

@@ -1,7 +1,8 @@
-//! Request and reply lines of `drivespec-cyclic/1` (README "Cyclic-exchange protocol").
+//! Request and reply lines of `drivespec-cyclic/1` (README "Cyclic-exchange protocol"): the
+//! PSD4xx records (`READ`/`WRITE`) and the PSx3xx ISDU requests (`ISDU-READ`/`ISDU-WRITE`).
 //!
 //! Words are separated by single blanks; numbers are decimal (times in µs, signed values with
-//! `-`); byte strings are hex without separators (upper or lower case). Unknown words give a
+//! `-`); byte strings are hex without separators (upper or lower case), `-` when empty. Unknown words give a
 //! [`WireError`], never a panic.
 
 use drivespec_psd4xx::model::LinkEvent;
@@ -25,8 +26,28 @@ pub enum Env {
     MissSteps(i64),
     /// `temperature C`: device temperature in °C.
     Temperature(i16),
-    /// `link lost|connected|iops-bad|iops-good`: the bus connection (3.9).
+    /// `link lost|connected|iops-bad|iops-good`: the bus connection (PSD4xx 3.9; PSx3xx 5.9
+    /// knows `lost` and `connected`).
     Link(LinkEvent),
+    /// `control-voltage DV`: control supply in 0.1 V; 0 switches the device off.
+    ControlVoltage(u16),
+    /// `load-torque CNM`: extra load torque on the shaft in cNm.
+    LoadTorque(u16),
+    /// `back-drive RPM`: the shaft is turned externally at this speed; 0 stops it.
+    BackDrive(i32),
+    /// `block POS`: a hard block at this position.
+    Block(i64),
+    /// `clear-blocks 0`: every block removed.
+    ClearBlocks,
+    /// `position-fault 0`: an internal problem in the position calculation.
+    PositionFault,
+    /// `keys none|forward|reverse|both`: the jog key inputs (PSx3xx 5.10).
+    Keys {
+        /// Forward key (pin 2) pressed.
+        forward: bool,
+        /// Reverse key (pin 3) pressed.
+        reverse: bool,
+    },
 }
 
 /// A request from the runner.
@@ -71,6 +92,26 @@ pub enum Request {
         /// Record data.
         data: Vec<u8>,
     },
+    /// `ISDU-READ T INDEX SUBINDEX`: an IO-Link ISDU read (PSx3xx 3.1).
+    IsduRead {
+        /// Virtual time (µs).
+        t: u64,
+        /// ISDU index.
+        index: u16,
+        /// Sub-index (0: the whole index).
+        subindex: u8,
+    },
+    /// `ISDU-WRITE T INDEX SUBINDEX HEX`: an IO-Link ISDU write (PSx3xx 3.1).
+    IsduWrite {
+        /// Virtual time (µs).
+        t: u64,
+        /// ISDU index.
+        index: u16,
+        /// Sub-index (0: the whole index).
+        subindex: u8,
+        /// Value octets, most significant first.
+        data: Vec<u8>,
+    },
     /// `ENV T NAME VALUE`: an environment injection.
     Env {
         /// Virtual time (µs).
@@ -104,6 +145,10 @@ pub enum Reply {
     Refused(u32),
     /// `MALFORMED`: the record data has the wrong length.
     Malformed,
+    /// `ISDU-ERROR NAME`: the ISDU request was refused with this IO-Link ErrorType, named as
+    /// in the spec's `protocol.isdu_errors.code` table (`IDX_NOTAVAIL`), or as hex (`0x8011`)
+    /// when it has no name.
+    IsduError(String),
     /// `SILENT`: no answer at all (switched off).
     Silent,
     /// `UNSUPPORTED`: the adapter cannot do this injection.
@@ -145,6 +190,15 @@ pub fn unhex(s: &str) -> Option<Vec<u8>> {
         .collect()
 }
 
+/// A byte string as one protocol word: hex, or `-` when empty.
+fn word(bytes: &[u8]) -> String {
+    if bytes.is_empty() {
+        "-".to_owned()
+    } else {
+        hex(bytes)
+    }
+}
+
 fn link_name(e: LinkEvent) -> &'static str {
     match e {
         LinkEvent::Lost => "lost",
@@ -164,6 +218,18 @@ impl fmt::Display for Env {
             Env::MissSteps(n) => write!(f, "miss-steps {n}"),
             Env::Temperature(c) => write!(f, "temperature {c}"),
             Env::Link(e) => write!(f, "link {}", link_name(*e)),
+            Env::ControlVoltage(dv) => write!(f, "control-voltage {dv}"),
+            Env::LoadTorque(cnm) => write!(f, "load-torque {cnm}"),
+            Env::BackDrive(rpm) => write!(f, "back-drive {rpm}"),
+            Env::Block(at) => write!(f, "block {at}"),
+            Env::ClearBlocks => f.write_str("clear-blocks 0"),
+            Env::PositionFault => f.write_str("position-fault 0"),
+            Env::Keys { forward, reverse } => f.write_str(match (forward, reverse) {
+                (false, false) => "keys none",
+                (true, false) => "keys forward",
+                (false, true) => "keys reverse",
+                (true, true) => "keys both",
+            }),
         }
     }
 }
@@ -177,10 +243,19 @@ impl fmt::Display for Request {
                 model,
             } => write!(f, "HELLO drivespec-cyclic {version} {family} {model}"),
             Request::Reset => f.write_str("RESET"),
-            Request::Cycle { t, image } => write!(f, "CYCLE {t} {}", hex(image)),
+            Request::Cycle { t, image } => write!(f, "CYCLE {t} {}", word(image)),
             Request::Advance { t } => write!(f, "ADVANCE {t}"),
             Request::Read { t, index } => write!(f, "READ {t} {index}"),
-            Request::Write { t, index, data } => write!(f, "WRITE {t} {index} {}", hex(data)),
+            Request::Write { t, index, data } => write!(f, "WRITE {t} {index} {}", word(data)),
+            Request::IsduRead { t, index, subindex } => {
+                write!(f, "ISDU-READ {t} {index} {subindex}")
+            }
+            Request::IsduWrite {
+                t,
+                index,
+                subindex,
+                data,
+            } => write!(f, "ISDU-WRITE {t} {index} {subindex} {}", word(data)),
             Request::Env { t, env } => write!(f, "ENV {t} {env}"),
         }
     }
@@ -191,12 +266,13 @@ impl fmt::Display for Reply {
         match self {
             Reply::Hello { version, name } => write!(f, "HELLO drivespec-cyclic {version} {name}"),
             Reply::Ok => f.write_str("OK"),
-            Reply::In(b) => write!(f, "IN {}", hex(b)),
-            Reply::Data(b) => write!(f, "DATA {}", hex(b)),
+            Reply::In(b) => write!(f, "IN {}", word(b)),
+            Reply::Data(b) => write!(f, "DATA {}", word(b)),
             Reply::Written => f.write_str("WRITTEN"),
             Reply::Ignored => f.write_str("IGNORED"),
             Reply::Refused(c) => write!(f, "REFUSED {c}"),
             Reply::Malformed => f.write_str("MALFORMED"),
+            Reply::IsduError(name) => write!(f, "ISDU-ERROR {name}"),
             Reply::Silent => f.write_str("SILENT"),
             Reply::Unsupported => f.write_str("UNSUPPORTED"),
             Reply::Err(t) => write!(f, "ERR {t}"),
@@ -210,8 +286,11 @@ fn num<T: std::str::FromStr>(line: &str, w: Option<&str>, what: &str) -> Result<
 }
 
 fn bytes(line: &str, w: Option<&str>) -> Result<Vec<u8>, WireError> {
-    w.and_then(unhex)
-        .ok_or_else(|| bad(line, "expected hex bytes"))
+    match w {
+        Some("-") => Some(Vec::new()),
+        other => other.and_then(unhex),
+    }
+    .ok_or_else(|| bad(line, "expected hex bytes"))
 }
 
 fn end(line: &str, mut words: std::str::SplitWhitespace<'_>) -> Result<(), WireError> {
@@ -260,6 +339,17 @@ impl Request {
                 index: num(line, w.next(), "index")?,
                 data: bytes(line, w.next())?,
             },
+            "ISDU-READ" => Request::IsduRead {
+                t: num(line, w.next(), "time")?,
+                index: num(line, w.next(), "index")?,
+                subindex: num(line, w.next(), "sub-index")?,
+            },
+            "ISDU-WRITE" => Request::IsduWrite {
+                t: num(line, w.next(), "time")?,
+                index: num(line, w.next(), "index")?,
+                subindex: num(line, w.next(), "sub-index")?,
+                data: bytes(line, w.next())?,
+            },
             "ENV" => {
                 let t = num(line, w.next(), "time")?;
                 let name = w.next().unwrap_or("");
@@ -278,6 +368,22 @@ impl Request {
                         Some("iops-good") => LinkEvent::IopsGood,
                         _ => return Err(bad(line, "expected lost|connected|iops-bad|iops-good")),
                     }),
+                    "control-voltage" => Env::ControlVoltage(num(line, value, "0.1 V")?),
+                    "load-torque" => Env::LoadTorque(num(line, value, "cNm")?),
+                    "back-drive" => Env::BackDrive(num(line, value, "rpm")?),
+                    "block" => Env::Block(num(line, value, "position")?),
+                    "clear-blocks" => Env::ClearBlocks,
+                    "position-fault" => Env::PositionFault,
+                    "keys" => {
+                        let (forward, reverse) = match value {
+                            Some("none") => (false, false),
+                            Some("forward") => (true, false),
+                            Some("reverse") => (false, true),
+                            Some("both") => (true, true),
+                            _ => return Err(bad(line, "expected none|forward|reverse|both")),
+                        };
+                        Env::Keys { forward, reverse }
+                    }
                     _ => return Err(bad(line, "unknown environment name")),
                 };
                 Request::Env { t, env }
@@ -313,6 +419,12 @@ impl Reply {
             "IGNORED" => Reply::Ignored,
             "REFUSED" => Reply::Refused(num(line, w.next(), "error code")?),
             "MALFORMED" => Reply::Malformed,
+            "ISDU-ERROR" => match w.next() {
+                Some(name) if name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_') => {
+                    Reply::IsduError(name.to_owned())
+                }
+                _ => return Err(bad(line, "expected an ErrorType name or hex")),
+            },
             "SILENT" => Reply::Silent,
             "UNSUPPORTED" => Reply::Unsupported,
             "ERR" => {
@@ -329,6 +441,7 @@ impl Reply {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::strategy::Strategy;
 
     #[test]
     fn requests_and_replies_round_trip() {
@@ -358,6 +471,36 @@ mod tests {
                 t: 2,
                 env: Env::Link(LinkEvent::IopsBad),
             },
+            Request::IsduRead {
+                t: 8000,
+                index: 0,
+                subindex: 10,
+            },
+            Request::IsduWrite {
+                t: 16_000,
+                index: 193,
+                subindex: 0,
+                data: vec![0xFF, 0xFE],
+            },
+            Request::Env {
+                t: 3,
+                env: Env::Keys {
+                    forward: true,
+                    reverse: false,
+                },
+            },
+            Request::Env {
+                t: 3,
+                env: Env::ControlVoltage(0),
+            },
+            Request::Env {
+                t: 3,
+                env: Env::BackDrive(-12),
+            },
+            Request::Env {
+                t: 3,
+                env: Env::ClearBlocks,
+            },
         ];
         for r in reqs {
             assert_eq!(Request::parse(&r.to_string()), Ok(r));
@@ -371,6 +514,9 @@ mod tests {
             Reply::Refused(17),
             Reply::Err("what".into()),
             Reply::Silent,
+            Reply::IsduError("IDX_NOTAVAIL".into()),
+            Reply::IsduError("0x8011".into()),
+            Reply::Data(Vec::new()),
         ];
         for r in replies {
             assert_eq!(Reply::parse(&r.to_string()), Ok(r));
@@ -414,11 +560,49 @@ mod tests {
             "READ 1",
             "ENV 1 warp 9",
             "OK extra",
+            "ISDU-READ 1 2",
+            "ISDU-READ 1 2 256",
+            "ISDU-WRITE 1 2 0",
+            "ENV 1 keys sideways",
+            "ISDU-ERROR",
+            "ISDU-ERROR A-B",
         ] {
             assert!(
                 Request::parse(bad).is_err() || Reply::parse(bad).is_err(),
                 "{bad}"
             );
+        }
+    }
+
+    proptest::proptest! {
+        /// No line, however garbled, makes either parser panic; what parses prints back to
+        /// the same request or reply.
+        #[test]
+        fn arbitrary_lines_never_panic(line in "\\PC{0,80}") {
+            if let Ok(r) = Request::parse(&line) {
+                proptest::prop_assert_eq!(Request::parse(&r.to_string()), Ok(r));
+            }
+            if let Ok(r) = Reply::parse(&line) {
+                proptest::prop_assert_eq!(Reply::parse(&r.to_string()), Ok(r));
+            }
+        }
+
+        /// Lines built from the protocol's own words, numbers and hex never panic either.
+        #[test]
+        fn protocol_words_never_panic(words in proptest::collection::vec(
+            proptest::prop_oneof![
+                proptest::sample::select(vec![
+                    "HELLO", "drivespec-cyclic", "RESET", "CYCLE", "ADVANCE", "READ", "WRITE",
+                    "ISDU-READ", "ISDU-WRITE", "ENV", "keys", "link", "both", "lost",
+                    "power-cycle", "IN", "DATA", "ISDU-ERROR", "REFUSED", "SILENT", "OK",
+                ]).prop_map(str::to_owned),
+                proptest::num::i64::ANY.prop_map(|n| n.to_string()),
+                "[0-9A-Fa-f]{0,9}",
+            ],
+            0..7,
+        )) {
+            let line = words.join(" ");
+            let _ = (Request::parse(&line), Reply::parse(&line));
         }
     }
 }

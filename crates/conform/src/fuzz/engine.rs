@@ -12,7 +12,7 @@ use super::stats::Stats;
 use crate::case::{CaseRun, Failure, RequirementRef};
 use crate::link::{Caps, LinkError};
 use crate::rng::Rng;
-use drivespec_spec::{FamilyId, Level};
+use drivespec_spec::{Family, FamilyId, Level};
 
 /// What one run of a sequence found.
 #[derive(Debug, Clone)]
@@ -37,7 +37,7 @@ pub(crate) struct Fault {
 }
 
 /// One family's fuzzing: sequences from the spec, and runs against the device and the
-/// reference model (HPD in [`super::hpd`]; PSD4xx and PSx3xx implement it next).
+/// reference model (HPD in [`super::hpd`], PSD4xx in [`super::psd4xx`]).
 pub(crate) trait Target {
     /// The family.
     fn family(&self) -> FamilyId;
@@ -410,7 +410,49 @@ pub(crate) fn replay_once(target: &mut dyn Target, steps: &[Step]) -> (Trial, St
     (target.run(steps), start)
 }
 
-/// Whether a step puts something on the line (for counting exchanges).
+/// True with `percent` % probability.
+pub(crate) fn chance(rng: &mut Rng, percent: i64) -> bool {
+    rng.range(0, 99) < percent
+}
+
+/// A number in `0..n` (0 when `n` is 0).
+pub(crate) fn below(rng: &mut Rng, n: usize) -> usize {
+    let hi = i64::try_from(n).unwrap_or(i64::MAX).saturating_sub(1);
+    usize::try_from(rng.range(0, hi.max(0))).unwrap_or(0)
+}
+
+/// One of `items`, None when there are none.
+pub(crate) fn pick<'x, T>(rng: &mut Rng, items: &'x [T]) -> Option<&'x T> {
+    if items.is_empty() {
+        return None;
+    }
+    items.get(below(rng, items.len()))
+}
+
+/// Whether a step puts something on the line (for counting exchanges): every cyclic step
+/// is at least one request and reply.
 pub(crate) fn is_exchange(s: &Step) -> bool {
-    matches!(s.action, Action::Exchange { .. } | Action::Send { .. })
+    matches!(
+        s.action,
+        Action::Exchange { .. } | Action::Send { .. } | Action::Cyclic(_)
+    )
+}
+
+/// A requirement of `family` with its text, for reports ([`Target::requirement`]).
+pub(crate) fn requirement_ref(family: &Family, id: &str) -> Option<RequirementRef> {
+    family.requirement(id).map(|r| RequirementRef {
+        id: r.id.clone(),
+        level: r.level,
+        text: r.text.clone(),
+    })
+}
+
+/// Every must/should requirement ID of `family`, in spec order ([`Target::requirement_ids`]).
+pub(crate) fn requirement_ids(family: &Family) -> Vec<(String, Level)> {
+    family
+        .requirements
+        .iter()
+        .filter(|r| r.level != Level::Informative)
+        .map(|r| (r.id.clone(), r.level))
+        .collect()
 }

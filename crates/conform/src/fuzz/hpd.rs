@@ -6,7 +6,7 @@
 //! closed), a hang when the device was silent where the reference answers and stays silent
 //! to a liveness probe (a read of Pr33), and a mismatch otherwise.
 
-use super::engine::{Fault, Target, Trial};
+use super::engine::{self, Fault, Target, Trial};
 use super::hpd_gen::HpdGen;
 use super::replay::{Action, Compare, FindingClass, Start, Step};
 use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
@@ -132,6 +132,7 @@ impl<'a, 's> HpdTarget<'a, 's> {
             Some(Action::PowerCycle) => "power-cycle".to_owned(),
             Some(Action::Inputs { .. }) => "inputs".to_owned(),
             Some(Action::BitRate) => "bit-rate".to_owned(),
+            Some(Action::Cyclic(_)) => "cyclic".to_owned(),
             None => "start".to_owned(),
         }
     }
@@ -163,6 +164,9 @@ fn to_hpd(s: &Step) -> HStep {
         Action::PowerCycle => HAction::PowerCycle,
         Action::Inputs { value } => HAction::Inputs { value: *value },
         Action::BitRate => HAction::BitRate,
+        // Not an HPD step: replay files are checked on load (`Replay::from_json`) and the
+        // generator makes none, so this never runs; it would only listen for nothing.
+        Action::Cyclic(_) => HAction::Listen { us: 0 },
     };
     HStep {
         role: Role::Check,
@@ -296,19 +300,10 @@ impl Target for HpdTarget<'_, '_> {
     }
 
     fn requirement(&self, id: &str) -> Option<RequirementRef> {
-        self.family.requirement(id).map(|r| RequirementRef {
-            id: r.id.clone(),
-            level: r.level,
-            text: r.text.clone(),
-        })
+        engine::requirement_ref(self.family, id)
     }
 
     fn requirement_ids(&self) -> Vec<(String, Level)> {
-        self.family
-            .requirements
-            .iter()
-            .filter(|r| r.level != Level::Informative)
-            .map(|r| (r.id.clone(), r.level))
-            .collect()
+        engine::requirement_ids(self.family)
     }
 }

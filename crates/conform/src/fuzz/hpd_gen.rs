@@ -7,6 +7,7 @@
 //! The generator draws only from the [`Rng`] it is given; nothing here reads a clock or the
 //! device. Nothing panics: a message that cannot be built is skipped.
 
+use super::engine::{below, chance, pick};
 use super::replay::{Action, Compare, Step};
 use crate::case::Role;
 use crate::hpd::frame::frame;
@@ -125,22 +126,6 @@ pub(crate) struct HpdGen<'a, 's> {
     scan_us: Micros,
     /// Largest value of a drive address.
     addr_max: u8,
-}
-
-fn chance(rng: &mut Rng, percent: i64) -> bool {
-    rng.range(0, 99) < percent
-}
-
-fn below(rng: &mut Rng, n: usize) -> usize {
-    let hi = i64::try_from(n).unwrap_or(i64::MAX).saturating_sub(1);
-    usize::try_from(rng.range(0, hi.max(0))).unwrap_or(0)
-}
-
-fn pick<'x, T>(rng: &mut Rng, items: &'x [T]) -> Option<&'x T> {
-    if items.is_empty() {
-        return None;
-    }
-    items.get(below(rng, items.len()))
 }
 
 fn parse_bit(name: &str) -> Option<(u8, u8)> {

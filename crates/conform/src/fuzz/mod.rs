@@ -15,28 +15,33 @@
 //! device that dies or hangs is a finding, and the run goes on after restarting it. Nothing
 //! here panics on any device behaviour or replay file.
 //!
-//! HPD only for now; PSD4xx and PSx3xx join by implementing the crate-internal `Target`
-//! (`engine.rs`) with their generator and session.
+//! HPD (`hpd` target, serial frames) and PSD4xx (`psd4xx` target, the cyclic-exchange
+//! protocol); PSx3xx joins by implementing the crate-internal `Target` (`engine.rs`) with its
+//! generator and session.
 
 mod ddmin;
 mod engine;
 mod hpd;
 mod hpd_gen;
 mod output;
+mod psd4xx;
+mod psd4xx_gen;
 mod replay;
 mod stats;
 
 pub use output::{json as report_json, Finding};
 pub use replay::{
-    Action, Compare, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start, Step,
-    REPLAY_FORMAT,
+    Action, Compare, CyclicStep, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start,
+    Step, REPLAY_FORMAT,
 };
 pub use stats::{FindingSummary, Stats, STATS_SCHEMA};
 
 use crate::case::CaseRun;
+use crate::cyclic::{LinkPeer, Peer};
 use crate::dut::{shell_quote, Dut};
 use crate::hpd::HpdSuite;
 use crate::link::Link;
+use crate::psd4xx::Psd4xxSuite;
 use crate::report::{self, Report};
 use crate::runner::Progress;
 use crate::suite::{Settings, SetupError};
@@ -52,7 +57,7 @@ pub const DEFAULT_ITERATIONS: u64 = 1000;
 /// Everything `drivespec fuzz` takes.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// The family (HPD only for now).
+    /// The family (HPD or PSD4xx).
     pub family: FamilyId,
     /// The device under test.
     pub dut: Dut,
@@ -99,7 +104,7 @@ impl Default for Options {
 #[non_exhaustive]
 pub enum FuzzError {
     /// The family has no fuzzer yet.
-    #[error("fuzzing {0} is not available yet: its reference model and conformance session are not written (only hpd)")]
+    #[error("fuzzing {0} is not available yet: it has no fuzz target (hpd and psd4xx have)")]
     NotAvailable(FamilyId),
     /// The suite, the reference or the transport could not be set up.
     #[error(transparent)]
@@ -182,24 +187,53 @@ fn effective(opts: &Options) -> Settings {
     settings
 }
 
-/// Builds the family's target on `link` (or the transport `opts.dut` names) and calls `f`.
+/// A device under test of the caller's, instead of the transport `Options::dut` names.
+pub enum Device {
+    /// A byte link: HPD frames, or `drivespec-cyclic/1` lines for PSD4xx.
+    Link(Box<dyn Link>),
+    /// A cyclic-exchange peer (PSD4xx): e.g. a [`crate::cyclic::LocalPeer`] on a test device.
+    Peer(Box<dyn Peer>),
+}
+
+/// How long a device on a link may take for one cyclic reply (a process may take a while to
+/// start): the protocol's time-out, as `drivespec conform` uses it.
+const CYCLIC_TIMEOUT_US: u64 = 2_000_000;
+
+/// Builds the family's target on `device` (or the transport `opts.dut` names) and calls `f`.
 fn with_target<R>(
     spec: &Spec,
     opts: &Options,
     settings: &Settings,
-    link: Option<Box<dyn Link>>,
+    device: Option<Device>,
     f: impl FnOnce(&mut dyn Target) -> Result<R, FuzzError>,
 ) -> Result<R, FuzzError> {
-    if opts.family != FamilyId::Hpd {
-        return Err(FuzzError::NotAvailable(opts.family));
+    match opts.family {
+        FamilyId::Hpd => {
+            let suite = HpdSuite::new(spec, settings)?;
+            let link = match device {
+                Some(Device::Link(l)) => l,
+                Some(Device::Peer(_)) => {
+                    return Err(FuzzError::Setup(SetupError::Usage(
+                        "hpd needs a byte link, not a cyclic-exchange peer".to_owned(),
+                    )))
+                }
+                None => suite.link(&opts.dut)?,
+            };
+            let mut target = hpd::HpdTarget::new(&suite, link)?;
+            f(&mut target)
+        }
+        FamilyId::Psd4xx => {
+            let suite = Psd4xxSuite::new(spec, settings)?;
+            let peer: Box<dyn Peer> = match device {
+                Some(Device::Peer(p)) => p,
+                Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
+                None => suite.peer(&opts.dut)?,
+            };
+            let mut target = psd4xx::Psd4xxTarget::new(&suite, peer)?;
+            f(&mut target)
+        }
+        other => Err(FuzzError::NotAvailable(other)),
     }
-    let suite = HpdSuite::new(spec, settings)?;
-    let link = match link {
-        Some(l) => l,
-        None => suite.link(&opts.dut)?,
-    };
-    let mut target = hpd::HpdTarget::new(&suite, link)?;
-    f(&mut target)
 }
 
 /// Runs a fuzzing campaign against `opts.dut` and writes the reports.
@@ -218,8 +252,19 @@ pub fn run_on(
     link: Box<dyn Link>,
     progress: &mut dyn Write,
 ) -> Result<Summary, FuzzError> {
+    run_on_device(spec, opts, Device::Link(link), progress)
+}
+
+/// [`run`] on a device of the caller's: a link, or a cyclic-exchange peer (PSD4xx mutants,
+/// embedding tools); `opts.dut` only names it in the reports.
+pub fn run_on_device(
+    spec: &Spec,
+    opts: &Options,
+    device: Device,
+    progress: &mut dyn Write,
+) -> Result<Summary, FuzzError> {
     let settings = effective(opts);
-    with_target(spec, opts, &settings, Some(link), |t| {
+    with_target(spec, opts, &settings, Some(device), |t| {
         campaign(t, opts, &settings, progress)
     })
 }
@@ -534,9 +579,21 @@ pub fn replay_on(
     r: &Replay,
     link: Box<dyn Link>,
 ) -> Result<ReplayOutcome, FuzzError> {
+    replay_on_device(spec, opts, r, Device::Link(link))
+}
+
+/// [`replay`] on a device of the caller's (a link or a cyclic-exchange peer).
+pub fn replay_on_device(
+    spec: &Spec,
+    opts: &Options,
+    r: &Replay,
+    device: Device,
+) -> Result<ReplayOutcome, FuzzError> {
     check_family(opts, r)?;
     let settings = replay_settings(opts, r);
-    with_target(spec, opts, &settings, Some(link), |t| Ok(replay_with(t, r)))
+    with_target(spec, opts, &settings, Some(device), |t| {
+        Ok(replay_with(t, r))
+    })
 }
 
 fn minimize_with(
@@ -584,7 +641,7 @@ pub fn minimize_on(
 ) -> Result<Option<Replay>, FuzzError> {
     check_family(opts, r)?;
     let settings = replay_settings(opts, r);
-    with_target(spec, opts, &settings, Some(link), |t| {
+    with_target(spec, opts, &settings, Some(Device::Link(link)), |t| {
         Ok(minimize_with(t, opts, &settings, r))
     })
 }

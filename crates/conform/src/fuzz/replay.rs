@@ -6,6 +6,7 @@
 //! fields its action needs are errors naming the step.
 
 use crate::case::Record;
+use crate::cyclic::{Env, Request};
 use crate::link::Micros;
 use drivespec_spec::hex::{parse_hex, to_hex};
 use drivespec_spec::FamilyId;
@@ -64,13 +65,111 @@ pub enum Action {
     },
     /// Follows the bit rate the reference uses now (serial ports, after b42.3).
     BitRate,
+    /// A step of the cyclic-exchange protocol (PSD4xx, README "Cyclic-exchange protocol").
+    Cyclic(CyclicStep),
+}
+
+/// What one step of a cyclic-exchange sequence does; device and reference get the same
+/// requests, every cycle's input image and every reply is judged (PSD4xx manual 3.5–3.9).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CyclicStep {
+    /// New control word and/or target (absent: unchanged), then one cycle (3.5.1).
+    Process {
+        /// Control word (par 32).
+        control: Option<u16>,
+        /// Target value (par 33).
+        target: Option<i32>,
+    },
+    /// New control word (absent: unchanged) and a target this far from the reference's actual
+    /// position, then one cycle.
+    Offset {
+        /// Control word (par 32).
+        control: Option<u16>,
+        /// Target minus actual position (increments).
+        offset: i64,
+    },
+    /// A PKW block, any code (3.8), cycled until the reference answers it (at most 8 cycles).
+    Pkw {
+        /// Command code AK (0–15).
+        ak: u8,
+        /// SPM bit.
+        spm: bool,
+        /// Parameter number.
+        pnu: u16,
+        /// Subindex word IND.
+        ind: u16,
+        /// Parameter value PWE.
+        pwe: u32,
+    },
+    /// Cycles with the outputs unchanged.
+    Hold {
+        /// How many.
+        cycles: u32,
+    },
+    /// Cycles until the reference runs (`true`) or stands still, at most `max`.
+    Until {
+        /// Wait for "drive is running" set (true) or a standstill (false).
+        running: bool,
+        /// Most cycles.
+        max: u32,
+    },
+    /// An acyclic record read (3.2.2).
+    RecordRead {
+        /// Record index (= parameter number).
+        index: u16,
+    },
+    /// An acyclic record write, control byte first (3.2.2).
+    RecordWrite {
+        /// Record index (= parameter number).
+        index: u16,
+        /// The data.
+        data: Vec<u8>,
+    },
+    /// An environment injection (`ENV`).
+    Env(Env),
+    /// Time passes without a bus cycle (`ADVANCE`).
+    Advance {
+        /// How long (µs).
+        us: Micros,
+    },
+}
+
+impl CyclicStep {
+    fn name(&self) -> &'static str {
+        match self {
+            CyclicStep::Process { .. } => "process",
+            CyclicStep::Offset { .. } => "offset",
+            CyclicStep::Pkw { .. } => "pkw",
+            CyclicStep::Hold { .. } => "hold",
+            CyclicStep::Until { .. } => "until",
+            CyclicStep::RecordRead { .. } => "record-read",
+            CyclicStep::RecordWrite { .. } => "record-write",
+            CyclicStep::Env(_) => "env",
+            CyclicStep::Advance { .. } => "advance",
+        }
+    }
+}
+
+/// The PKW block of a `pkw` step in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PkwFile {
+    ak: u8,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    spm: bool,
+    pnu: u16,
+    #[serde(default)]
+    ind: u16,
+    #[serde(default)]
+    pwe: u32,
 }
 
 impl Action {
-    /// The bytes the step puts on the line, if any.
+    /// The bytes the step puts on the line, if any (a record write: its data).
     pub fn bytes(&self) -> Option<&[u8]> {
         match self {
             Action::Exchange { bytes, .. } | Action::Send { bytes } => Some(bytes),
+            Action::Cyclic(CyclicStep::RecordWrite { data, .. }) => Some(data),
             _ => None,
         }
     }
@@ -88,6 +187,12 @@ impl Action {
                 silence_ok: *silence_ok,
             },
             Action::Send { .. } => Action::Send { bytes: new },
+            Action::Cyclic(CyclicStep::RecordWrite { index, .. }) => {
+                Action::Cyclic(CyclicStep::RecordWrite {
+                    index: *index,
+                    data: new,
+                })
+            }
             other => other.clone(),
         }
     }
@@ -102,6 +207,7 @@ impl Action {
             Action::PowerCycle => "power-cycle",
             Action::Inputs { .. } => "inputs",
             Action::BitRate => "bit-rate",
+            Action::Cyclic(c) => c.name(),
         }
     }
 }
@@ -178,7 +284,8 @@ pub struct FindingInfo {
     pub reproduced: bool,
 }
 
-/// What one step gave when the file was written (hex; empty: silence).
+/// What one step gave when the file was written (hex; empty: silence; the request and reply
+/// lines for cyclic records and injections).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Observed {
@@ -206,12 +313,25 @@ pub struct Observed {
 impl Observed {
     /// The observation of an evidence record, with times from `t0`.
     pub fn of(r: &Record, t0: Micros) -> Observed {
+        // Cyclic records and injections travel as lines, not bytes: their lines are kept.
+        let lines = r.sent.is_none() && r.sent_text.is_some();
+        let shown = |a: &crate::case::Answer| {
+            if lines {
+                a.text.clone()
+            } else {
+                a.hex.clone()
+            }
+        };
         Observed {
             step: r.step,
             at_us: r.at_us.saturating_sub(t0),
-            sent: r.sent.clone(),
-            expected: r.expected.as_ref().map(|a| a.hex.clone()),
-            got: r.got.as_ref().map(|a| a.hex.clone()),
+            sent: if lines {
+                r.sent_text.clone()
+            } else {
+                r.sent.clone()
+            },
+            expected: r.expected.as_ref().map(shown),
+            got: r.got.as_ref().map(shown),
             ok: r.ok,
             note: r.note.clone(),
         }
@@ -311,12 +431,35 @@ struct StepFile {
     us: Option<Micros>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     value: Option<u16>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    control: Option<u16>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    target: Option<i32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    offset: Option<i64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pkw: Option<PkwFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cycles: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    running: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    max: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    index: Option<u16>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    env: Option<String>,
     #[serde(default)]
     class: String,
     #[serde(default, skip_serializing_if = "String::is_empty")]
     text: String,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     requirements: Vec<String>,
+}
+
+/// `v`, or an error naming the step, its action and the missing key.
+fn need<T>(v: Option<T>, index: usize, action: &str, key: &str) -> Result<T, String> {
+    v.ok_or_else(|| format!("step {index}: `{action}` needs `{key}`"))
 }
 
 impl StepFile {
@@ -328,6 +471,15 @@ impl StepFile {
             silence_ok: false,
             us: None,
             value: None,
+            control: None,
+            target: None,
+            offset: None,
+            pkw: None,
+            cycles: None,
+            running: None,
+            max: None,
+            index: None,
+            env: None,
             class: s.class.clone(),
             text: s.text.clone(),
             requirements: s.requirements.clone(),
@@ -343,12 +495,48 @@ impl StepFile {
             }
             Action::Listen { us } => f.us = Some(*us),
             Action::Inputs { value } => f.value = Some(*value),
+            Action::Cyclic(c) => match c {
+                CyclicStep::Process { control, target } => {
+                    f.control = *control;
+                    f.target = *target;
+                }
+                CyclicStep::Offset { control, offset } => {
+                    f.control = *control;
+                    f.offset = Some(*offset);
+                }
+                CyclicStep::Pkw {
+                    ak,
+                    spm,
+                    pnu,
+                    ind,
+                    pwe,
+                } => {
+                    f.pkw = Some(PkwFile {
+                        ak: *ak,
+                        spm: *spm,
+                        pnu: *pnu,
+                        ind: *ind,
+                        pwe: *pwe,
+                    })
+                }
+                CyclicStep::Hold { cycles } => f.cycles = Some(*cycles),
+                CyclicStep::Until { running, max } => {
+                    f.running = Some(*running);
+                    f.max = Some(*max);
+                }
+                CyclicStep::RecordRead { index } | CyclicStep::RecordWrite { index, .. } => {
+                    f.index = Some(*index)
+                }
+                CyclicStep::Env(env) => f.env = Some(env.to_string()),
+                CyclicStep::Advance { us } => f.us = Some(*us),
+            },
             _ => {}
         }
         f
     }
 
     fn step(self, index: usize) -> Result<Step, String> {
+        let action_name = self.action.clone();
         let bytes = || -> Result<Vec<u8>, String> {
             let hex = self
                 .hex
@@ -377,9 +565,51 @@ impl StepFile {
                     .ok_or_else(|| format!("step {index}: `inputs` needs `value`"))?,
             },
             "bit-rate" => Action::BitRate,
+            "process" => Action::Cyclic(CyclicStep::Process {
+                control: self.control,
+                target: self.target,
+            }),
+            "offset" => Action::Cyclic(CyclicStep::Offset {
+                control: self.control,
+                offset: need(self.offset, index, &action_name, "offset")?,
+            }),
+            "pkw" => {
+                let p = need(self.pkw, index, &action_name, "pkw")?;
+                Action::Cyclic(CyclicStep::Pkw {
+                    ak: p.ak,
+                    spm: p.spm,
+                    pnu: p.pnu,
+                    ind: p.ind,
+                    pwe: p.pwe,
+                })
+            }
+            "hold" => Action::Cyclic(CyclicStep::Hold {
+                cycles: need(self.cycles, index, &action_name, "cycles")?,
+            }),
+            "until" => Action::Cyclic(CyclicStep::Until {
+                running: need(self.running, index, &action_name, "running")?,
+                max: need(self.max, index, &action_name, "max")?,
+            }),
+            "record-read" => Action::Cyclic(CyclicStep::RecordRead {
+                index: need(self.index, index, &action_name, "index")?,
+            }),
+            "record-write" => Action::Cyclic(CyclicStep::RecordWrite {
+                index: need(self.index, index, &action_name, "index")?,
+                data: bytes()?,
+            }),
+            "env" => {
+                let text = need(self.env.clone(), index, &action_name, "env")?;
+                match Request::parse(&format!("ENV 0 {text}")) {
+                    Ok(Request::Env { env, .. }) => Action::Cyclic(CyclicStep::Env(env)),
+                    _ => return Err(format!("step {index}: env {text:?}: not an injection (e.g. \"jam 1\")")),
+                }
+            }
+            "advance" => Action::Cyclic(CyclicStep::Advance {
+                us: need(self.us, index, &action_name, "us")?,
+            }),
             other => {
                 return Err(format!(
-                    "step {index}: unknown action {other:?} (exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate)"
+                    "step {index}: unknown action {other:?} (exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate; cyclic: process, offset, pkw, hold, until, record-read, record-write, env, advance)"
                 ))
             }
         };
@@ -436,6 +666,18 @@ impl Replay {
             .map(|(i, s)| s.step(i))
             .collect::<Result<Vec<Step>, String>>()
             .map_err(bad)?;
+        let cyclic = f.family != FamilyId::Hpd;
+        if let Some((i, s)) = steps
+            .iter()
+            .enumerate()
+            .find(|(_, s)| matches!(s.action, Action::Cyclic(_)) != cyclic)
+        {
+            return Err(bad(format!(
+                "step {i}: `{}` is not a {} step",
+                s.action.name(),
+                f.family
+            )));
+        }
         if let Some(fi) = &f.finding {
             if fi.step >= steps.len() {
                 return Err(bad(format!(
@@ -545,6 +787,71 @@ mod tests {
         assert_eq!(r.steps.len(), 3);
         assert_eq!(r.steps[1].action, Action::ListenTimeout);
         assert_eq!(r.start, Start::Fresh);
+    }
+
+    #[test]
+    fn cyclic_steps_round_trip_and_stay_in_their_family() {
+        let step = |c: CyclicStep| Step {
+            action: Action::Cyclic(c),
+            class: "x".into(),
+            text: String::new(),
+            requirements: vec![],
+        };
+        let r = Replay {
+            family: FamilyId::Psd4xx,
+            steps: vec![
+                step(CyclicStep::Process {
+                    control: Some(0x14),
+                    target: Some(-4000),
+                }),
+                step(CyclicStep::Process {
+                    control: None,
+                    target: None,
+                }),
+                step(CyclicStep::Offset {
+                    control: Some(0x54),
+                    offset: 12,
+                }),
+                step(CyclicStep::Pkw {
+                    ak: 15,
+                    spm: true,
+                    pnu: 2047,
+                    ind: 3,
+                    pwe: u32::MAX,
+                }),
+                step(CyclicStep::Hold { cycles: 3 }),
+                step(CyclicStep::Until {
+                    running: false,
+                    max: 100,
+                }),
+                step(CyclicStep::RecordRead { index: 44 }),
+                step(CyclicStep::RecordWrite {
+                    index: 44,
+                    data: vec![1, 0, 5],
+                }),
+                step(CyclicStep::Env(Env::Jam(true))),
+                step(CyclicStep::Env(Env::Link(
+                    drivespec_psd4xx::model::LinkEvent::IopsBad,
+                ))),
+                step(CyclicStep::Advance { us: 2_500_000 }),
+            ],
+            ..sample()
+        };
+        let text = r.to_json();
+        assert_eq!(Replay::from_json(&text, "x").unwrap(), r);
+        assert!(text.contains("\"env\": \"link iops-bad\""), "{text}");
+        // Cyclic steps in an HPD file, a bad injection or a missing key are refused.
+        let hpd = text.replace("\"psd4xx\"", "\"hpd\"");
+        assert!(Replay::from_json(&hpd, "x").is_err());
+        let bad = text.replace("jam 1", "warp 9");
+        assert!(Replay::from_json(&bad, "x").is_err());
+        let bad = text.replace("\"cycles\": 3", "\"cylces\": 3");
+        assert!(Replay::from_json(&bad, "x").is_err());
+        let mut hpd_with_cyclic = sample();
+        hpd_with_cyclic
+            .steps
+            .push(step(CyclicStep::Hold { cycles: 1 }));
+        assert!(Replay::from_json(&hpd_with_cyclic.to_json(), "x").is_err());
     }
 
     #[test]

@@ -133,7 +133,16 @@ impl Stats {
             let verdict = match r.ok {
                 None => continue,
                 Some(true) => {
-                    if r.got.as_ref().is_some_and(|a| !a.is_silence()) {
+                    // Cyclic records and injections are lines: `SILENT` is their silence.
+                    let lines = r.sent.is_none() && r.sent_text.is_some();
+                    let answered = r.got.as_ref().is_some_and(|a| {
+                        if lines {
+                            a.text != "SILENT"
+                        } else {
+                            !a.is_silence()
+                        }
+                    });
+                    if answered {
                         "answer"
                     } else {
                         "silence"

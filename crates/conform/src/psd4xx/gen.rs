@@ -41,6 +41,8 @@ pub(crate) enum Action {
     Record(RecordRequest),
     /// An environment injection.
     Env(Env),
+    /// Time passes by this many µs without a bus cycle (`ADVANCE`).
+    Advance(u64),
 }
 
 /// Most cycles a PKW command is repeated before the case moves on (PSD-PKW-002).
@@ -69,14 +71,14 @@ pub(crate) struct Tolerance {
 }
 
 /// Tolerance of the motion cases: ±3 cycles, ±20 increments, ±2 rpm.
-const MOTION: Tolerance = Tolerance {
+pub(crate) const MOTION: Tolerance = Tolerance {
     cycles: 3,
     position: 20,
     speed: 2,
 };
 
 /// Tolerance of the PKW and record cases: the answer may come one cycle late.
-const EXCHANGE: Tolerance = Tolerance {
+pub(crate) const EXCHANGE: Tolerance = Tolerance {
     cycles: 1,
     position: 0,
     speed: 0,
@@ -103,7 +105,7 @@ struct Gen<'a> {
 }
 
 /// Control-word values by their spec name (bitfield `control`, 4.1).
-fn control(family: &Family, name: &str) -> Result<u16, String> {
+pub(crate) fn control(family: &Family, name: &str) -> Result<u16, String> {
     family
         .bitfield("control")
         .and_then(|b| b.values.iter().find(|v| v.name == name))
@@ -112,7 +114,7 @@ fn control(family: &Family, name: &str) -> Result<u16, String> {
 }
 
 /// The control bit named `name` as a mask (bitfield `control`, 3.7).
-fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
+pub(crate) fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
     family
         .bitfield("control")
         .and_then(|b| b.bits.iter().find(|x| x.name == name))

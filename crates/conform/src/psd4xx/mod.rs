@@ -17,8 +17,7 @@
 //! block and status word exactly; position and speed within the case's declared tolerance,
 //! and a time tolerance in cycles for the motion cases.
 
-mod gen;
-pub mod plot;
+pub(crate) mod gen;
 mod session;
 
 pub use session::Psd4xxSession;
@@ -83,7 +82,7 @@ impl<'s> Psd4xxSuite<'s> {
     }
 
     /// A server on the reference drive (what `sim` runs, and what tests serve over tcp).
-    pub fn server(&self) -> Server {
+    pub fn server(&self) -> Server<'static> {
         Server::new(
             &format!("drivespec reference {}", self.model),
             FamilyId::Psd4xx.as_str(),
@@ -104,7 +103,7 @@ impl<'s> Psd4xxSuite<'s> {
         Some((self.infos.get(index)?, self.cases.get(index)?))
     }
 
-    fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
+    pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
         // Real peers get 2 s per reply (a process may take a while to start).
         const TIMEOUT_US: u64 = 2_000_000;
         Ok(match dut {

@@ -2,11 +2,11 @@
 //! requests; every cycle's input image and every record and injection reply is compared.
 
 use super::gen::{status_bit, Action, PsdCase, Tolerance, PKW_MAX_CYCLES};
-use super::plot::{self, Sample};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::cyclic::wire::hex;
-use crate::cyclic::{Peer, Reply, Request, Server, VERSION};
+use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server, VERSION};
+use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, Output, PkwRequest};
@@ -16,6 +16,8 @@ use drivespec_spec::FamilyId;
 pub struct Psd4xxSession<'a, 's> {
     suite: &'a Psd4xxSuite<'s>,
     peer: Box<dyn Peer>,
+    /// The first transport failure of the case run last (a crash or hang to the fuzzer).
+    peer_error: Option<PeerError>,
 }
 
 /// One cycle as both sides saw it.
@@ -28,7 +30,7 @@ struct Cycle {
 
 /// What one case run collected.
 struct Run<'r> {
-    reference: Server,
+    reference: Server<'static>,
     out: Output,
     t: u64,
     cycles: Vec<Cycle>,
@@ -39,7 +41,11 @@ struct Run<'r> {
 
 impl<'a, 's> Psd4xxSession<'a, 's> {
     pub(crate) fn new(suite: &'a Psd4xxSuite<'s>, peer: Box<dyn Peer>) -> Psd4xxSession<'a, 's> {
-        Psd4xxSession { suite, peer }
+        Psd4xxSession {
+            suite,
+            peer,
+            peer_error: None,
+        }
     }
 
     /// Exchanges `HELLO`; an error names what the device side said.
@@ -57,6 +63,36 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
             )),
             Err(e) => Err(format!("{}: {e}", self.peer.describe())),
         }
+    }
+
+    /// The first transport failure of the case run last, if any (taken).
+    pub(crate) fn take_peer_error(&mut self) -> Option<PeerError> {
+        self.peer_error.take()
+    }
+
+    /// Whether the device takes the injection `env` (`ENV` answered `OK`; the injections are
+    /// optional, README "Cyclic-exchange protocol"). The device is reset after it; a transport
+    /// failure counts as no (and the device is restarted).
+    pub(crate) fn takes(&mut self, env: Env) -> bool {
+        let ok = match self.peer.call(&Request::Env { t: 0, env }) {
+            Ok(r) => r == Reply::Ok,
+            Err(_) => {
+                self.restart();
+                return false;
+            }
+        };
+        if self.peer.call(&Request::Reset).is_err() {
+            self.restart();
+        }
+        ok
+    }
+
+    /// Notes a transport failure, then reconnects or restarts the peer and greets it again.
+    fn failed(&mut self, e: &PeerError) {
+        if self.peer_error.is_none() {
+            self.peer_error = Some(e.clone());
+        }
+        self.restart();
     }
 
     /// After a transport error: reconnect or restart the peer and greet it again.
@@ -109,7 +145,7 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
         let dut = match self.peer.call(&req) {
             Ok(r) => self.parse_input(&r),
             Err(e) => {
-                self.restart();
+                self.failed(&e);
                 run.cycles.push(Cycle {
                     step,
                     t: run.t,
@@ -145,7 +181,7 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
         let got = match self.peer.call(&req) {
             Ok(r) => r.to_string(),
             Err(e) => {
-                self.restart();
+                self.failed(&e);
                 format!("error: {e}")
             }
         };
@@ -276,6 +312,14 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
                     }
                     continue;
                 }
+                Action::Advance(us) => {
+                    run.t = run.t.saturating_add(*us);
+                    let req = Request::Advance { t: run.t };
+                    if !self.exact(run, n, s.role, &s.text, req) {
+                        return Ok(());
+                    }
+                    continue;
+                }
             }
             // One record per cycle step: the last cycle of the step.
             let image = run
@@ -389,7 +433,10 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
         }
     }
 
-    fn run_case(&mut self, info: &CaseInfo, case: &PsdCase) -> CaseRun {
+    /// Runs one case (a generated one, or a fuzz sequence) against the device and a fresh
+    /// reference.
+    pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &PsdCase) -> CaseRun {
+        self.peer_error = None;
         let rules = self.suite.reference().rules();
         let mut run = Run {
             reference: self.suite.server(),
@@ -404,7 +451,7 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
             Ok(Reply::Ok) => Ok(()),
             Ok(other) => Err(format!("RESET answered with {other}")),
             Err(e) => {
-                self.restart();
+                self.failed(&e);
                 Err(e.to_string())
             }
         };

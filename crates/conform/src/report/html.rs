@@ -195,9 +195,9 @@ fn case(h: &mut String, c: &CaseReport) {
     for e in c
         .evidence
         .iter()
-        .filter(|e| e.action == crate::psd4xx::plot::ACTION)
+        .filter(|e| e.action == crate::plot::ACTION)
     {
-        if let Some(svg) = e.note.as_deref().and_then(crate::psd4xx::plot::svg) {
+        if let Some(svg) = e.note.as_deref().and_then(crate::plot::svg) {
             let _ = writeln!(h, "<p>{svg}</p>");
         }
     }

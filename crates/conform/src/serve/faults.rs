@@ -1,5 +1,5 @@
-//! Seeded fault injection (`--drop-answers`, `--corrupt-checksums`, `--delay-ms`, `--seed`):
-//! the same seed and the same traffic always give the same faults.
+//! Seeded fault injection (`--drop-answers`, `--corrupt-checksums`, `--corrupt-images`,
+//! `--delay-ms`, `--seed`): the same seed and the same traffic always give the same faults.
 
 use super::ServeError;
 use crate::link::Micros;
@@ -12,6 +12,9 @@ pub struct Faults {
     pub drop_answers: f64,
     /// Probability (0–1) that a message with a checksum is sent with a wrong one.
     pub corrupt_checksums: f64,
+    /// Probability (0–1) that an input image (`IN` reply of `drivespec-cyclic/1`) is sent
+    /// with one bit flipped.
+    pub corrupt_images: f64,
     /// Extra delay of every message the device sends (µs).
     pub delay_us: Micros,
     /// Seed of the fault decisions.
@@ -24,6 +27,7 @@ impl Faults {
         for (name, p) in [
             ("--drop-answers", self.drop_answers),
             ("--corrupt-checksums", self.corrupt_checksums),
+            ("--corrupt-images", self.corrupt_images),
         ] {
             if !(0.0..=1.0).contains(&p) {
                 return Err(ServeError::Usage(format!(
@@ -36,7 +40,10 @@ impl Faults {
 
     /// No fault at all.
     pub fn none(&self) -> bool {
-        self.drop_answers == 0.0 && self.corrupt_checksums == 0.0 && self.delay_us == 0
+        self.drop_answers == 0.0
+            && self.corrupt_checksums == 0.0
+            && self.corrupt_images == 0.0
+            && self.delay_us == 0
     }
 
     /// The flags, as `drivespec sim` takes them (for the banner).
@@ -50,6 +57,9 @@ impl Faults {
         }
         if self.corrupt_checksums > 0.0 {
             parts.push(format!("--corrupt-checksums {}", self.corrupt_checksums));
+        }
+        if self.corrupt_images > 0.0 {
+            parts.push(format!("--corrupt-images {}", self.corrupt_images));
         }
         if self.delay_us > 0 {
             parts.push(format!("--delay-ms {}", self.delay_us as f64 / 1000.0));
@@ -103,6 +113,17 @@ impl Dice {
     pub(crate) fn delay(&self) -> Micros {
         self.faults.delay_us
     }
+
+    /// Whether the next input image gets a bit flipped.
+    pub(crate) fn corrupt_image(&mut self) -> bool {
+        self.chance(self.faults.corrupt_images)
+    }
+
+    /// A position in `0..n` (0 when `n` is 0): which bit to flip.
+    pub(crate) fn pick(&mut self, n: usize) -> usize {
+        let n = u64::try_from(n).unwrap_or(u64::MAX).max(1);
+        usize::try_from(self.rng.next_u64() % n).unwrap_or(0)
+    }
 }
 
 #[cfg(test)]
@@ -114,6 +135,7 @@ mod tests {
         let f = Faults {
             drop_answers: 0.25,
             corrupt_checksums: 0.5,
+            corrupt_images: 0.0,
             delay_us: 0,
             seed: 9,
         };

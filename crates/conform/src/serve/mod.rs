@@ -1,8 +1,9 @@
 //! `drivespec sim`: a family's reference model served in real time on a byte stream, so
 //! masters and PLC drivers can be developed and tested against it.
 //!
-//! - [`mod@device`]: the served model behind [`ServedDevice`] (HPD's reference [`Drive`] now;
-//!   PSD4xx and PSx3xx join with their models and the cyclic-exchange protocol).
+//! - [`mod@device`]: the served model behind [`ServedDevice`] (HPD's reference [`Drive`]).
+//! - PSD4xx and PSx3xx speak the cyclic-exchange protocol instead: [`with_cyclic_server`] and
+//!   [`serve_cyclic_tcp`], [`serve_cyclic_stream`], `serve_cyclic_pty` (module `cyclic`).
 //! - Transports: [`serve_tcp`] (one client at a time), [`serve_pty`] on a [`Pty`] (Unix: a
 //!   pseudo-terminal whose path any serial library opens) and [`serve_stream`]/[`serve_stdio`].
 //! - [`Faults`]: seeded fault injection for a client's error handling: answers dropped,
@@ -21,6 +22,7 @@
 //!
 //! [`Drive`]: drivespec_hpd::model::Drive
 
+mod cyclic;
 pub mod device;
 mod engine;
 mod faults;
@@ -28,6 +30,9 @@ pub(crate) mod port;
 #[cfg(unix)]
 mod pty;
 
+#[cfg(unix)]
+pub use cyclic::serve_cyclic_pty;
+pub use cyclic::{serve_cyclic_stdio, serve_cyclic_stream, serve_cyclic_tcp, with_cyclic_server};
 pub use device::{device, DeviceOptions, Emitted, HpdDevice, ServedDevice};
 pub use engine::{Options, Stats, Stop};
 pub use faults::Faults;
@@ -46,7 +51,7 @@ use std::time::Duration;
 #[non_exhaustive]
 pub enum ServeError {
     /// The family has no model to serve yet.
-    #[error("serving {family} is not available yet: its reference model is not served on the cyclic-exchange protocol (issue 6, section 2) yet; only hpd can be served now")]
+    #[error("serving {family} is not available yet: its reference model has no server")]
     NotAvailable {
         /// The family asked for.
         family: FamilyId,

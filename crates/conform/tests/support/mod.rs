@@ -1,5 +1,6 @@
-//! Shared test support: the HPD mutants (`mutants`) and the reference drive on a TCP port
-//! (`reference_server`, behind `faulty_relay.py`). Each test file uses only part of it.
+//! Shared test support: the HPD mutants (`mutants`), the PSD4xx mutants (`psd4xx_mutants`)
+//! and the reference drive on a TCP port (`reference_server`, behind `faulty_relay.py`). Each
+//! test file uses only part of it.
 #![allow(
     dead_code,
     missing_docs,
@@ -10,4 +11,5 @@
 )]
 
 pub mod mutants;
+pub mod psd4xx_mutants;
 pub mod reference_server;

@@ -1,4 +1,5 @@
-//! The position/speed/status plot of a positioning case: the samples travel in the evidence
+//! The position/speed/status plot of a positioning case (PSD4xx and PSx3xx): the samples
+//! travel in the evidence
 //! (a cleanup record with action [`ACTION`], at most [`MAX_POINTS`] samples as text in its
 //! note) and the HTML report draws them as a small inline SVG with [`svg`].
 

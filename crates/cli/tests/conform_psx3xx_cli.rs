@@ -1,0 +1,100 @@
+//! `drivespec conform psx3xx` as users run it: against the built-in model with `--dut
+//! sim:MODEL`, and through `exec:` with `drivespec sim psx3xx --stdio` as the device, both
+//! writing the JSON report; `all` includes PSx3xx.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_drivespec")
+}
+
+fn report_dir(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!(
+        "drivespec-conform-psx3xx-{name}-{}",
+        std::process::id()
+    ))
+}
+
+/// Runs `drivespec conform` with `args`; exit code, output and the JSON report.
+fn conform(name: &str, args: &[&str]) -> (i32, String, serde_json::Value) {
+    let dir = report_dir(name);
+    let out = Command::new(bin())
+        .arg("conform")
+        .args(args)
+        .args(["--quiet", "--report-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = std::fs::read_to_string(dir.join("conform.json")).unwrap_or_default();
+    let _ = std::fs::remove_dir_all(&dir);
+    (
+        out.status.code().unwrap_or(-1),
+        text,
+        serde_json::from_str(&json).unwrap_or(serde_json::Value::Null),
+    )
+}
+
+#[test]
+fn sim_with_a_model_suffix_passes() {
+    let (code, out, json) = conform(
+        "sim",
+        &[
+            "psx3xx",
+            "--dut",
+            "sim:PSS325-14",
+            "--case",
+            "psx3xx/format/*",
+            "--case",
+            "psx3xx/guard/109/*",
+        ],
+    );
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("against sim:PSS325-14"), "{out}");
+    assert_eq!(json["run"]["families"][0], "psx3xx");
+    assert!(json["summary"]["passed"].as_u64().unwrap() >= 15, "{json}");
+}
+
+#[test]
+fn exec_against_the_served_model_passes() {
+    let dut = format!("exec:{} sim psx3xx --stdio", bin());
+    let (code, out, json) = conform(
+        "exec",
+        &[
+            "psx3xx",
+            "--dut",
+            &dut,
+            "--case",
+            "psx3xx/isdu/unknown-*",
+            "--case",
+            "psx3xx/timestamp/position",
+            "--case",
+            "psx3xx/status/jog-keys",
+        ],
+    );
+    assert_eq!(code, 0, "{out}");
+    assert_eq!(json["summary"]["failed"], 0, "{json}");
+    assert!(json["summary"]["passed"].as_u64().unwrap() >= 5, "{json}");
+}
+
+#[test]
+fn all_lists_psx3xx_cases() {
+    let out = Command::new(bin())
+        .args(["conform", "all", "--list", "--case", "psx3xx/guard/*"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("psx3xx/guard/66/suppress"), "{text}");
+}

@@ -1,0 +1,308 @@
+//! The PSD4xx fuzz target: sequences from [`super::psd4xx_gen`], run as a case through the
+//! conformance session ([`Psd4xxSession`]) over the cyclic-exchange protocol, so every cycle's
+//! input image and every record and injection reply is judged exactly as `drivespec conform`
+//! judges it: the reference drive fed the same requests, PKW and status exact, position and
+//! speed within the motion cases' tolerance when the sequence moves the drive (manual 3.5–3.9,
+//! chapter 4).
+//!
+//! Environment injections are optional in the protocol: before the first sequence each kind
+//! the generator uses is tried once (then `RESET`), and only the kinds the device takes
+//! (`OK`) are sent.
+//!
+//! A failing step is a crash when the transport failed (the process exited, the connection
+//! closed), a hang when the device sent no reply within the protocol's time-out (2 s), and a
+//! mismatch otherwise; the signature names the step kind and the fields that differ.
+
+use super::engine::{self, Fault, Target, Trial};
+use super::psd4xx_gen::{env_kind, PsdGen, ENV_KINDS};
+use super::replay::{Action, CyclicStep, FindingClass, Start, Step};
+use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use crate::cyclic::{Peer, PeerError};
+use crate::link::{Caps, LinkError};
+use crate::psd4xx::gen::{self, PsdCase, StepDef, EXCHANGE, MOTION};
+use crate::psd4xx::{Psd4xxSession, Psd4xxSuite};
+use crate::rng::Rng;
+use crate::suite::SetupError;
+use drivespec_psd4xx::model::RecordRequest;
+use drivespec_psd4xx::{Input, PkwRequest};
+use drivespec_spec::hex::parse_hex;
+use drivespec_spec::{FamilyId, Level};
+
+/// The PSD4xx target on one device under test.
+pub(crate) struct Psd4xxTarget<'a, 's> {
+    suite: &'a Psd4xxSuite<'s>,
+    session: Psd4xxSession<'a, 's>,
+    gen: PsdGen,
+}
+
+impl<'a, 's> Psd4xxTarget<'a, 's> {
+    /// A target on `peer` (greeted with `HELLO`), with the reference from `suite`.
+    pub(crate) fn new(
+        suite: &'a Psd4xxSuite<'s>,
+        peer: Box<dyn Peer>,
+    ) -> Result<Psd4xxTarget<'a, 's>, SetupError> {
+        let mut session = suite.session(peer);
+        session.hello().map_err(SetupError::Usage)?;
+        // Only the injections the device takes are sent (they are optional).
+        let envs: Vec<String> = ENV_KINDS
+            .iter()
+            .filter(|e| session.takes(**e))
+            .map(env_kind)
+            .collect();
+        let gen = PsdGen::new(suite, envs).map_err(SetupError::Spec)?;
+        Ok(Psd4xxTarget {
+            suite,
+            session,
+            gen,
+        })
+    }
+
+    fn case(&self, steps: &[Step]) -> (CaseInfo, PsdCase) {
+        let mut requirements: Vec<String> = steps
+            .iter()
+            .flat_map(|s| s.requirements.iter().cloned())
+            .collect();
+        requirements.sort();
+        requirements.dedup();
+        let info = CaseInfo {
+            id: "psd4xx/fuzz/sequence".to_owned(),
+            family: FamilyId::Psd4xx,
+            requirements,
+            level: Level::Must,
+            description: "a fuzz sequence".to_owned(),
+            steps: steps.iter().map(|s| s.text.clone()).collect(),
+        };
+        // The motion cases' tolerance as soon as anything may move the drive; the exchange
+        // cases' otherwise.
+        let moves = steps.iter().any(|s| {
+            !matches!(
+                s.action,
+                Action::Cyclic(
+                    CyclicStep::Pkw { .. }
+                        | CyclicStep::Hold { .. }
+                        | CyclicStep::RecordRead { .. }
+                        | CyclicStep::RecordWrite { .. }
+                        | CyclicStep::Advance { .. }
+                )
+            )
+        });
+        let case = PsdCase {
+            steps: steps.iter().map(to_case_step).collect(),
+            tol: if moves { MOTION } else { EXCHANGE },
+            plot: false,
+        };
+        (info, case)
+    }
+
+    /// Which parts of the failing step's answer differ: `reply` for records and injections,
+    /// the input-image fields otherwise (`status-b<bits>`, `pkw-code`, `pkw-value`, `speed`,
+    /// `position`).
+    fn differs(&self, run: &CaseRun, step: usize) -> String {
+        let Some(r) = run
+            .evidence
+            .iter()
+            .find(|r| r.step == step && r.ok == Some(false))
+        else {
+            return "input-image".to_owned();
+        };
+        if r.note.as_deref() == Some("exact") {
+            return "reply".to_owned();
+        }
+        let rules = self.suite.reference().rules();
+        let image = |a: Option<&crate::case::Answer>| {
+            a.and_then(|a| parse_hex(&a.hex).ok())
+                .and_then(|b| Input::parse(rules, &b).ok())
+        };
+        let (Some(e), Some(g)) = (image(r.expected.as_ref()), image(r.got.as_ref())) else {
+            return "no-image".to_owned();
+        };
+        let mut parts: Vec<String> = Vec::new();
+        if e.pkw.ak != g.pkw.ak {
+            parts.push("pkw-code".to_owned());
+        } else if e.pkw != g.pkw {
+            parts.push("pkw-value".to_owned());
+        }
+        let bits = e.status ^ g.status;
+        if bits != 0 {
+            let list: Vec<String> = (0..16u16)
+                .filter(|b| bits & (1 << b) != 0)
+                .map(|b| b.to_string())
+                .collect();
+            parts.push(format!("status-b{}", list.join("+")));
+        }
+        if e.speed != g.speed {
+            parts.push("speed".to_owned());
+        }
+        if e.actual != g.actual {
+            parts.push("position".to_owned());
+        }
+        if parts.is_empty() {
+            // The last cycle of the step agrees; an earlier one did not.
+            "input-image".to_owned()
+        } else {
+            parts.join(",")
+        }
+    }
+}
+
+/// Most cycles one `hold` or `until` step runs (10 min of bus time at 10 ms): a replay file
+/// cannot make a run endless.
+const MAX_STEP_CYCLES: u32 = 60_000;
+
+/// Longest `advance` step (10 min).
+const MAX_ADVANCE_US: u64 = 600_000_000;
+
+/// What kind of step a fuzz step is, for signatures.
+fn kind(s: Option<&Step>) -> String {
+    match s.map(|s| &s.action) {
+        Some(Action::Cyclic(CyclicStep::Pkw { ak, .. })) => format!("pkw-ak{ak}"),
+        Some(Action::Cyclic(CyclicStep::Env(env))) => {
+            let text = env.to_string();
+            format!("env-{}", text.split(' ').next().unwrap_or("?"))
+        }
+        Some(Action::Cyclic(c)) => match c {
+            CyclicStep::Process { .. } => "process",
+            CyclicStep::Offset { .. } => "offset",
+            CyclicStep::Hold { .. } => "hold",
+            CyclicStep::Until { .. } => "until",
+            CyclicStep::RecordRead { .. } => "record-read",
+            CyclicStep::RecordWrite { .. } => "record-write",
+            CyclicStep::Advance { .. } => "advance",
+            CyclicStep::Pkw { .. } | CyclicStep::Env(_) => "cyclic",
+        }
+        .to_owned(),
+        Some(_) => "not-cyclic".to_owned(),
+        None => "start".to_owned(),
+    }
+}
+
+/// A fuzz step as a conformance step (judged). Steps of other protocols never reach here
+/// (replay files are checked on load); they would cycle once with the outputs unchanged.
+fn to_case_step(s: &Step) -> StepDef {
+    let action = match &s.action {
+        Action::Cyclic(c) => match c {
+            CyclicStep::Process { control, target } => gen::Action::Process {
+                control: *control,
+                target: *target,
+            },
+            CyclicStep::Offset { control, offset } => gen::Action::Offset {
+                control: *control,
+                offset: *offset,
+            },
+            CyclicStep::Pkw {
+                ak,
+                spm,
+                pnu,
+                ind,
+                pwe,
+            } => gen::Action::Pkw(PkwRequest {
+                ak: (*ak).into(),
+                spm: *spm,
+                pnu: *pnu,
+                ind: *ind,
+                pwe: *pwe,
+            }),
+            CyclicStep::Hold { cycles } => gen::Action::Hold((*cycles).min(MAX_STEP_CYCLES)),
+            CyclicStep::Until { running, max } => gen::Action::Until {
+                running: *running,
+                max: (*max).min(MAX_STEP_CYCLES),
+            },
+            CyclicStep::RecordRead { index } => {
+                gen::Action::Record(RecordRequest::Read { index: *index })
+            }
+            CyclicStep::RecordWrite { index, data } => gen::Action::Record(RecordRequest::Write {
+                index: *index,
+                data: data.clone(),
+            }),
+            CyclicStep::Env(env) => gen::Action::Env(*env),
+            CyclicStep::Advance { us } => gen::Action::Advance((*us).min(MAX_ADVANCE_US)),
+        },
+        _ => gen::Action::Hold(1),
+    };
+    StepDef {
+        role: Role::Check,
+        text: s.text.clone(),
+        action,
+    }
+}
+
+impl Target for Psd4xxTarget<'_, '_> {
+    fn family(&self) -> FamilyId {
+        FamilyId::Psd4xx
+    }
+
+    fn describe(&self) -> String {
+        crate::suite::Session::describe(&self.session)
+    }
+
+    fn caps(&self) -> Caps {
+        // Every run starts with `RESET` on the device and a fresh reference, on any transport;
+        // times are virtual (carried in the requests).
+        Caps {
+            reset: true,
+            power_cycle: true,
+            virtual_time: true,
+            inputs: false,
+        }
+    }
+
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
+        self.gen.sequence(rng)
+    }
+
+    fn fresh(&mut self) -> Result<Start, LinkError> {
+        // The case run resets both sides itself (and restarts a device that died).
+        Ok(Start::Fresh)
+    }
+
+    fn warm_up(&mut self) {}
+
+    fn run(&mut self, steps: &[Step]) -> Trial {
+        let (info, case) = self.case(steps);
+        let mut run = self.session.run_case(&info, &case);
+        let peer_error = self.session.take_peer_error();
+        let Outcome::Fail(mut failure) = run.outcome.clone() else {
+            return Trial { run, fault: None };
+        };
+        let step = failure.step.unwrap_or(0);
+        let (class, detail) = match &peer_error {
+            Some(PeerError::Timeout { .. }) => (FindingClass::Hang, String::new()),
+            Some(PeerError::Link(_)) => (FindingClass::Crash, String::new()),
+            Some(PeerError::Garbage { .. }) => (FindingClass::Mismatch, "/garbage".to_owned()),
+            None => (
+                FindingClass::Mismatch,
+                format!("/{}", self.differs(&run, step)),
+            ),
+        };
+        // The failing step's requirements, not the whole sequence's.
+        if let Some(s) = steps.get(step) {
+            failure.requirements = s
+                .requirements
+                .iter()
+                .filter_map(|id| self.requirement(id))
+                .collect();
+        }
+        if let Some(e) = &peer_error {
+            failure.message = format!("{} ({e})", failure.message);
+        }
+        run.outcome = Outcome::Fail(failure.clone());
+        let signature = format!("{}/{}{detail}", class.as_str(), kind(steps.get(step)));
+        Trial {
+            run,
+            fault: Some(Fault {
+                class,
+                step,
+                signature,
+                failure,
+            }),
+        }
+    }
+
+    fn requirement(&self, id: &str) -> Option<RequirementRef> {
+        engine::requirement_ref(self.suite.family(), id)
+    }
+
+    fn requirement_ids(&self) -> Vec<(String, Level)> {
+        engine::requirement_ids(self.suite.family())
+    }
+}

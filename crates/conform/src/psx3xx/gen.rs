@@ -1,0 +1,2198 @@
+//! Case generation for the PSx3xx suite: data-driven from the spec's ISDU table (ranges per
+//! model, access, data types), the ErrorType cases, the guard entries, the ISDU 2 / 193
+//! commands, the three process-data formats, the time-stamp and target-speed tables and the
+//! time-out table, plus hand-written status, time-out and positioning sequences (manual 3–5).
+
+use crate::case::{CaseInfo, Role};
+use crate::cyclic::Env;
+use drivespec_psx3xx::guard::Guards;
+use drivespec_psx3xx::isdu::{Request, Target, Value};
+use drivespec_psx3xx::model::Drive;
+use drivespec_psx3xx::{Output, Rules, Stamp, TsCode};
+use drivespec_spec::{Access, DataType, DeviceModel, Family, FamilyId, Level, Parameter, Readings};
+
+/// ISDU entries the hand-written sequences use (manual 3.1 table); every value, range and
+/// code they carry is read from the spec.
+mod isdu {
+    /// ISDU 12, device access locks (bit 0: parameter write lock).
+    pub const LOCKS: &str = "12";
+    /// ISDU 64, status word (3.4).
+    pub const STATUS: &str = "64";
+    /// ISDU 67, actual position.
+    pub const ACTUAL: &str = "67";
+    /// ISDU 129, upper limit.
+    pub const UPPER_LIMIT: &str = "129";
+    /// ISDU 130, lower limit.
+    pub const LOWER_LIMIT: &str = "130";
+    /// ISDU 131, positioning window.
+    pub const WINDOW: &str = "131";
+    /// ISDU 134, loop direction.
+    pub const LOOP_DIRECTION: &str = "134";
+    /// ISDU 135, jog increment: the saved entry the save and lock cases change.
+    pub const PROBE: &str = "135";
+    /// ISDU 163, wait time for a manual run in jog mode (5 ms steps).
+    pub const JOG_WAIT: &str = "163";
+    /// ISDU 181, motor voltage limit (0.1 V).
+    pub const UMOT_LIMIT: &str = "181";
+    /// ISDU 182, temperature limit (°C).
+    pub const TEMPERATURE_LIMIT: &str = "182";
+    /// ISDU 193, delivery state and save command.
+    pub const DELIVERY_STATE: &str = "193";
+    /// ISDU 2, IO-Link standard command (write only).
+    pub const STANDARD_COMMAND: &str = "2";
+}
+
+/// One action of a case; the device and the reference get exactly the same inputs.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Action {
+    /// A new process output (in the format active at that point), then one cycle.
+    Out(Output),
+    /// Cycles with the output unchanged.
+    Hold(u32),
+    /// Cycles until the reference's status bit "Drive is running" is set (`true`) or the
+    /// reference stands still (`false`), at most `max`.
+    Until {
+        /// Wait for running (true) or standstill (false).
+        running: bool,
+        /// Most cycles.
+        max: u32,
+    },
+    /// The master stays silent this long (µs): time passes without bus cycles.
+    Silence(u64),
+    /// An ISDU request between two cycles.
+    Isdu(Request),
+    /// An environment injection.
+    Env(Env),
+}
+
+/// One step: who it is for, one line, what it does.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct StepDef {
+    /// Setup, check or cleanup.
+    pub role: Role,
+    /// One line.
+    pub text: String,
+    /// What to do.
+    pub action: Action,
+}
+
+/// Declared tolerances of a case (physics); everything else is exact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct Tolerance {
+    /// A device sample may match a reference sample this many cycles earlier or later.
+    pub cycles: u32,
+    /// Actual position, steps.
+    pub position: i64,
+    /// Speed, rpm.
+    pub speed: i64,
+}
+
+/// Tolerance of the motion cases: ±3 cycles, ±20 steps, ±2 rpm.
+const MOTION: Tolerance = Tolerance {
+    cycles: 3,
+    position: 20,
+    speed: 2,
+};
+
+/// Tolerance of the ISDU cases: every cycle and every live value exact.
+const EXACT: Tolerance = Tolerance {
+    cycles: 0,
+    position: 0,
+    speed: 0,
+};
+
+/// A generated case.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PsxCase {
+    /// The output the master sends before the first `Out` step: all zero in the delivery
+    /// format.
+    pub start: Output,
+    /// The steps.
+    pub steps: Vec<StepDef>,
+    /// Tolerances.
+    pub tol: Tolerance,
+    /// Whether the report gets a position/speed/status plot.
+    pub plot: bool,
+}
+
+fn step(role: Role, text: impl Into<String>, action: Action) -> StepDef {
+    StepDef {
+        role,
+        text: text.into(),
+        action,
+    }
+}
+
+/// The rule that a new format takes effect only after a save and a restart.
+const FORMAT_SWITCH: &str = "PSX-PD-010";
+
+/// Cycles a status is held before the next change: more than twice the motion tolerance, so
+/// a missing bit cannot hide behind the time tolerance.
+const SETTLE: u32 = 10;
+
+/// Most cycles a run is waited for (8 ms each: 80 s).
+const RUN_MAX: u32 = 10_000;
+
+struct Gen<'a, 's> {
+    family: &'a Family,
+    model: &'a DeviceModel,
+    rules: &'a Rules<'s>,
+    base: &'a Drive<'s>,
+    cycle_us: u64,
+    errors: Vec<String>,
+    out: Vec<(CaseInfo, PsxCase)>,
+}
+
+/// The ISDU address of a parameter (manual 3.1).
+fn address(p: &Parameter) -> Option<(u16, u8)> {
+    Some((
+        u16::try_from(p.number).ok()?,
+        u8::try_from(p.subindex.unwrap_or(0)).ok()?,
+    ))
+}
+
+/// The octets of an entry's data type, None for strings (manual 3.1).
+fn width(t: DataType) -> Option<usize> {
+    t.width().and_then(|w| usize::try_from(w).ok())
+}
+
+impl<'a, 's> Gen<'a, 's> {
+    fn push(&mut self, id: String, reqs: &[String], description: String, case: PsxCase) {
+        let mut reqs = reqs.to_vec();
+        // A case that writes ISDU 116 relies on the format switching only after a restart.
+        let format = self.rules.protocol().format_select.param.as_str();
+        let format_index = self
+            .family
+            .parameters
+            .iter()
+            .find(|p| p.id == format)
+            .and_then(address);
+        let writes_format = case.steps.iter().any(|s| match &s.action {
+            Action::Isdu(Request::Write {
+                index, subindex, ..
+            }) => format_index == Some((*index, *subindex)),
+            _ => false,
+        });
+        if writes_format {
+            reqs.push(FORMAT_SWITCH.to_owned());
+        }
+        let mut requirements: Vec<String> = Vec::new();
+        let mut level = Level::Informative;
+        for r in &reqs {
+            match self.family.requirement(r) {
+                Some(q) => {
+                    level = level.min(q.level);
+                    requirements.push(q.id.clone());
+                }
+                None => self.errors.push(format!("{id}: unknown requirement {r}")),
+            }
+        }
+        if requirements.is_empty() {
+            self.errors.push(format!("{id}: no requirement"));
+        }
+        requirements.sort();
+        requirements.dedup();
+        let steps = case.steps.iter().map(|s| s.text.clone()).collect();
+        self.out.push((
+            CaseInfo {
+                id,
+                family: FamilyId::Psx3xx,
+                requirements,
+                level,
+                description,
+                steps,
+            },
+            case,
+        ));
+    }
+
+    fn case(&mut self, id: &str, reqs: &[&str], description: &str, steps: Vec<StepDef>) {
+        let reqs: Vec<String> = reqs.iter().map(|r| (*r).to_owned()).collect();
+        self.push(
+            format!("psx3xx/{id}"),
+            &reqs,
+            description.to_owned(),
+            PsxCase {
+                start: self.idle(self.rules.default_format()),
+                steps,
+                tol: EXACT,
+                plot: false,
+            },
+        );
+    }
+
+    fn motion(&mut self, id: &str, reqs: &[&str], description: &str, steps: Vec<StepDef>) {
+        let reqs: Vec<String> = reqs.iter().map(|r| (*r).to_owned()).collect();
+        self.push(
+            format!("psx3xx/{id}"),
+            &reqs,
+            description.to_owned(),
+            PsxCase {
+                start: self.idle(self.rules.default_format()),
+                steps,
+                tol: MOTION,
+                plot: true,
+            },
+        );
+    }
+
+    fn param(&mut self, id: &str) -> Option<&'a Parameter> {
+        let p = self.family.parameters.iter().find(|p| p.id == id);
+        if p.is_none() {
+            self.errors.push(format!("no parameter {id}"));
+        }
+        p
+    }
+
+    /// Requirements whose `params` name the entry (spec `requirement.params`).
+    fn reqs_of(&self, id: &str) -> Vec<String> {
+        self.family
+            .requirements
+            .iter()
+            .filter(|r| r.params.iter().any(|p| p == id))
+            .map(|r| r.id.clone())
+            .collect()
+    }
+
+    fn has_req(&self, id: &str) -> bool {
+        self.family.requirement(id).is_some()
+    }
+
+    fn range(&self, p: &Parameter) -> Option<Vec<[i64; 2]>> {
+        let r = self.family.resolve(p, Some(self.model)).range?;
+        Some(r.intervals().to_vec())
+    }
+
+    fn default_of(&self, p: &Parameter) -> Option<i64> {
+        self.family.resolve(p, Some(self.model)).default
+    }
+
+    /// The all-zero output of a format (manual 3.3.1); in format 0 the stamp is inactive.
+    fn idle(&self, format: u8) -> Output {
+        match format {
+            0 => Output::TimeStamp {
+                control: TsCode(0),
+                stamp: self.inactive(),
+            },
+            1 => Output::ControlTarget {
+                control_word: 0,
+                target: 0,
+            },
+            _ => Output::SpeedControlTarget {
+                target_speed: 0,
+                control_word: 0,
+                target: 0,
+            },
+        }
+    }
+
+    fn inactive(&self) -> Stamp {
+        Stamp::inactive(self.rules.timestamp())
+    }
+
+    fn read(&mut self, id: &str) -> Option<StepDef> {
+        let p = self.param(id)?;
+        let (index, subindex) = address(p)?;
+        Some(step(
+            Role::Check,
+            format!("ISDU read {id} ({})", p.name),
+            Action::Isdu(Request::Read { index, subindex }),
+        ))
+    }
+
+    /// The octets of `value` for an entry, None when the data type cannot hold it.
+    fn encode(&self, p: &Parameter, value: i64) -> Option<Vec<u8>> {
+        let (index, subindex) = address(p)?;
+        let target: Target<'_> = self.rules.isdu_target(index, subindex).ok()?;
+        self.rules.encode_value(&target, &Value::Int(value)).ok()
+    }
+
+    fn write(&mut self, role: Role, id: &str, value: i64) -> Option<StepDef> {
+        let p = self.param(id)?;
+        let (index, subindex) = address(p)?;
+        let Some(data) = self.encode(p, value) else {
+            self.errors
+                .push(format!("ISDU {id} cannot hold the value {value}"));
+            return None;
+        };
+        Some(step(
+            role,
+            format!("ISDU write {id} ({}) = {value}", p.name),
+            Action::Isdu(Request::Write {
+                index,
+                subindex,
+                data,
+            }),
+        ))
+    }
+
+    /// The reference's value of an entry at the start of every case.
+    fn value(&self, id: &str) -> i64 {
+        match self.base.value(id) {
+            Value::Int(v) => v,
+            _ => 0,
+        }
+    }
+
+    fn control(&mut self, name: &str) -> u16 {
+        let v = self
+            .family
+            .bitfield("control")
+            .and_then(|b| b.values.iter().find(|v| v.name == name))
+            .and_then(|v| u16::try_from(v.value).ok());
+        v.unwrap_or_else(|| {
+            self.errors.push(format!(
+                "no control-word value {name:?} in bitfield control"
+            ));
+            0
+        })
+    }
+
+    fn control_bit(&mut self, name: &str) -> u16 {
+        let v = self
+            .family
+            .bitfield("control")
+            .and_then(|b| b.bits.iter().find(|x| x.name == name))
+            .and_then(|x| 1u16.checked_shl(x.bit));
+        v.unwrap_or_else(|| {
+            self.errors.push(format!("no control bit {name:?}"));
+            0
+        })
+    }
+
+    fn f1(&self, control_word: u16, target: i64) -> Action {
+        Action::Out(Output::ControlTarget {
+            control_word,
+            target: i32::try_from(target).unwrap_or(0),
+        })
+    }
+
+    fn f2(&self, target_speed: i16, control_word: u16, target: i64) -> Action {
+        Action::Out(Output::SpeedControlTarget {
+            target_speed,
+            control_word,
+            target: i32::try_from(target).unwrap_or(0),
+        })
+    }
+
+    fn f0(&self, code: u8, stamp: Stamp) -> Action {
+        Action::Out(Output::TimeStamp {
+            control: TsCode(code),
+            stamp,
+        })
+    }
+
+    fn until(running: bool) -> Action {
+        Action::Until {
+            running,
+            max: RUN_MAX,
+        }
+    }
+
+    /// Cycles covering `ms` of bus time.
+    fn cycles_for(&self, ms: u64) -> u32 {
+        u32::try_from(ms.saturating_mul(1000).div_ceil(self.cycle_us.max(1))).unwrap_or(u32::MAX)
+    }
+
+    // ------------------------------------------------------------------ isdu
+
+    fn isdu_cases(&mut self) {
+        let params: Vec<&Parameter> = self.family.parameters.iter().collect();
+        let err_ro = "PSX-DP-ERR-003";
+        let err_range = "PSX-DP-ERR-004";
+        let err_wo = "PSX-DP-ERR-007";
+        let mut record_indices: Vec<u16> = Vec::new();
+        for p in &params {
+            let Some((index, subindex)) = address(p) else {
+                continue;
+            };
+            let mut reqs = self.reqs_of(&p.id);
+            if !p.access.readable() {
+                reqs.push(err_wo.to_owned());
+            }
+            if index == self.rules.protocol().direct_parameters.isdu_index {
+                reqs.push("PSX-DP-009".to_owned());
+            }
+            if reqs.is_empty() {
+                // Entries no requirement names: the delivery value of the table (3.1).
+                reqs.push("PSX-PAR-DEFAULTS".to_owned());
+            }
+            if subindex > 0 && !record_indices.contains(&index) {
+                record_indices.push(index);
+            }
+            self.push(
+                format!("psx3xx/isdu/read/{}", p.id),
+                &reqs,
+                format!("ISDU read of {} ({}) after power-on", p.id, p.name),
+                PsxCase {
+                    start: self.idle(self.rules.default_format()),
+                    steps: vec![step(
+                        Role::Check,
+                        format!("ISDU read {index}.{subindex}"),
+                        Action::Isdu(Request::Read { index, subindex }),
+                    )],
+                    tol: EXACT,
+                    plot: false,
+                },
+            );
+            if p.access == Access::R {
+                let len = width(p.data_type).unwrap_or(1);
+                let mut reqs = self.reqs_of(&p.id);
+                reqs.push(err_ro.to_owned());
+                self.push(
+                    format!("psx3xx/isdu/read-only/{}", p.id),
+                    &reqs,
+                    format!("a write to the read-only {} ({}) is refused", p.id, p.name),
+                    PsxCase {
+                        start: self.idle(1),
+                        steps: vec![
+                            step(
+                                Role::Check,
+                                format!("ISDU write {index}.{subindex} with {len} zero octet(s)"),
+                                Action::Isdu(Request::Write {
+                                    index,
+                                    subindex,
+                                    data: vec![0; len],
+                                }),
+                            ),
+                            step(
+                                Role::Check,
+                                "read back: unchanged",
+                                Action::Isdu(Request::Read { index, subindex }),
+                            ),
+                        ],
+                        tol: EXACT,
+                        plot: false,
+                    },
+                );
+            }
+            if p.access.writable() {
+                self.range_cases(p, err_range);
+            }
+        }
+        for index in record_indices {
+            self.case(
+                &format!("isdu/read/{index}/all"),
+                &["PSX-DP-009"],
+                &format!("ISDU read of the whole record {index} (sub-index 0)"),
+                vec![step(
+                    Role::Check,
+                    format!("ISDU read {index}.0"),
+                    Action::Isdu(Request::Read { index, subindex: 0 }),
+                )],
+            );
+        }
+        self.unknown_cases(&params);
+        self.length_cases();
+        self.lock_case();
+    }
+
+    /// Writes at both range edges and one beyond, each read back (manual 3.1, 3.2).
+    fn range_cases(&mut self, p: &Parameter, err_range: &str) {
+        // Only declared ranges (3.1, 3.2); a data type's own limits are no range rule.
+        if p.range.is_none() && !p.range_model {
+            return;
+        }
+        let Some(intervals) = self.range(p) else {
+            return;
+        };
+        let (Some(first), Some(last)) = (intervals.first(), intervals.last()) else {
+            return;
+        };
+        let (min, max) = (first[0], last[1]);
+        let mut values = vec![
+            ("min".to_owned(), min, false),
+            ("max".to_owned(), max, false),
+            ("below-min".to_owned(), min.saturating_sub(1), true),
+            ("above-max".to_owned(), max.saturating_add(1), true),
+        ];
+        for w in intervals.windows(2) {
+            if let [a, b] = w {
+                let v = a[1].saturating_add(1);
+                if b[0] > v {
+                    values.push((format!("gap-{v}"), v, true));
+                }
+            }
+        }
+        let range_req = format!("PSX-ISDU-{}-RANGE", p.id);
+        for (name, v, beyond) in values {
+            let Some(data) = self.encode(p, v) else {
+                continue;
+            };
+            let Some((index, subindex)) = address(p) else {
+                continue;
+            };
+            // The range rule, and everything the spec says about the entry (a write
+            // exercises it).
+            let mut reqs = self.reqs_of(&p.id);
+            if self.has_req(&range_req) {
+                reqs.push(range_req.clone());
+            }
+            if beyond {
+                reqs.push(err_range.to_owned());
+            }
+            if reqs.is_empty() {
+                reqs.push("PSX-PAR-DEFAULTS".to_owned());
+            }
+            let mut steps = vec![step(
+                Role::Check,
+                format!("ISDU write {} = {v}", p.id),
+                Action::Isdu(Request::Write {
+                    index,
+                    subindex,
+                    data,
+                }),
+            )];
+            if p.access.readable() {
+                steps.push(step(
+                    Role::Check,
+                    "read back",
+                    Action::Isdu(Request::Read { index, subindex }),
+                ));
+            }
+            steps.push(step(Role::Check, "two cycles", Action::Hold(2)));
+            self.push(
+                format!("psx3xx/isdu/write/{}/{name}", p.id),
+                &reqs,
+                format!(
+                    "ISDU write of {} ({}) = {v} ({name} of the range){}",
+                    p.id,
+                    p.name,
+                    if beyond { ": refused, value kept" } else { "" }
+                ),
+                PsxCase {
+                    start: self.idle(self.rules.default_format()),
+                    steps,
+                    tol: EXACT,
+                    plot: false,
+                },
+            );
+        }
+    }
+
+    /// Indices and sub-indices the table does not have (IEC 61131-9 C.2.3, C.2.4).
+    fn unknown_cases(&mut self, params: &[&Parameter]) {
+        let used: Vec<u16> = params
+            .iter()
+            .filter_map(|p| address(p).map(|a| a.0))
+            .collect();
+        let mut unknown: Vec<u16> = Vec::new();
+        for i in 1..=u16::MAX {
+            if !used.contains(&i) && !unknown.contains(&i) {
+                unknown.push(i);
+                if unknown.len() == 2 {
+                    break;
+                }
+            }
+        }
+        if let Some(m) = used.iter().max() {
+            if let Some(next) = m.checked_add(1) {
+                unknown.push(next);
+            }
+        }
+        if !used.contains(&u16::MAX) {
+            unknown.push(u16::MAX);
+        }
+        unknown.dedup();
+        for index in unknown {
+            self.case(
+                &format!("isdu/unknown-index/{index}"),
+                &["PSX-DP-ERR-001"],
+                &format!("ISDU read and write of index {index}, which the device does not have"),
+                vec![
+                    step(
+                        Role::Check,
+                        format!("ISDU read {index}.0"),
+                        Action::Isdu(Request::Read { index, subindex: 0 }),
+                    ),
+                    step(
+                        Role::Check,
+                        format!("ISDU write {index}.0 = 00 01"),
+                        Action::Isdu(Request::Write {
+                            index,
+                            subindex: 0,
+                            data: vec![0, 1],
+                        }),
+                    ),
+                ],
+            );
+        }
+        // A nonzero sub-index on single-value entries, one past the last of a record.
+        let mut subs: Vec<(u16, u8)> = Vec::new();
+        for p in params {
+            let Some((index, sub)) = address(p) else {
+                continue;
+            };
+            if sub == 0 && subs.iter().all(|(_, s)| *s != 1) && p.access.writable() {
+                subs.push((index, 1));
+            }
+            if sub == 0
+                && p.access == Access::R
+                && !subs.iter().any(|(i, _)| *i == index)
+                && subs.len() < 2
+            {
+                subs.push((index, 1));
+            }
+        }
+        let mut last: Option<(u16, u8)> = None;
+        for p in params {
+            if let Some((index, sub)) = address(p) {
+                if sub > 0 && last.is_none_or(|(i, s)| i != index || s < sub) {
+                    last = Some((index, sub));
+                }
+            }
+        }
+        if let Some((index, sub)) = last {
+            if let Some(next) = sub.checked_add(1) {
+                subs.push((index, next));
+            }
+        }
+        for (index, subindex) in subs {
+            self.case(
+                &format!("isdu/unknown-subindex/{index}.{subindex}"),
+                &["PSX-DP-ERR-002"],
+                &format!("ISDU read and write of sub-index {subindex} of index {index}"),
+                vec![
+                    step(
+                        Role::Check,
+                        format!("ISDU read {index}.{subindex}"),
+                        Action::Isdu(Request::Read { index, subindex }),
+                    ),
+                    step(
+                        Role::Check,
+                        format!("ISDU write {index}.{subindex} = 00"),
+                        Action::Isdu(Request::Write {
+                            index,
+                            subindex,
+                            data: vec![0],
+                        }),
+                    ),
+                ],
+            );
+        }
+    }
+
+    /// Writes one octet too long and too short for every numeric width (IEC 61131-9 C.2.12,
+    /// C.2.13).
+    fn length_cases(&mut self) {
+        let mut widths: Vec<usize> = Vec::new();
+        let params: Vec<&Parameter> = self.family.parameters.iter().collect();
+        for p in params {
+            let Some(w) = width(p.data_type) else {
+                continue;
+            };
+            if !p.access.writable() || !p.access.readable() || widths.contains(&w) {
+                continue;
+            }
+            let Some((index, subindex)) = address(p) else {
+                continue;
+            };
+            let Some(good) = self.default_of(p).and_then(|d| self.encode(p, d)) else {
+                continue;
+            };
+            widths.push(w);
+            let mut long = vec![0u8];
+            long.extend(&good);
+            let short: Vec<u8> = good.iter().skip(1).copied().collect();
+            let mut cases = vec![("overrun", long)];
+            if !short.is_empty() {
+                cases.push(("underrun", short));
+            }
+            for (name, data) in cases {
+                self.case(
+                    &format!("isdu/length/{}/{name}", p.id),
+                    &["PSX-DP-ERR-006"],
+                    &format!(
+                        "ISDU write of {} ({}, {w} octet(s)) with {} octet(s): refused",
+                        p.id,
+                        p.name,
+                        data.len()
+                    ),
+                    vec![
+                        step(
+                            Role::Check,
+                            format!("ISDU write {index}.{subindex} with {} octet(s)", data.len()),
+                            Action::Isdu(Request::Write {
+                                index,
+                                subindex,
+                                data,
+                            }),
+                        ),
+                        step(
+                            Role::Check,
+                            "read back: unchanged",
+                            Action::Isdu(Request::Read { index, subindex }),
+                        ),
+                    ],
+                );
+            }
+        }
+    }
+
+    /// The parameter write lock of ISDU 12 bit 0 (IEC 61131-9 B.2.4).
+    fn lock_case(&mut self) {
+        let jog = isdu::PROBE;
+        let Some(p) = self.param(jog) else {
+            return;
+        };
+        let Some(max) = self.range(p).and_then(|r| r.last().map(|i| i[1])) else {
+            return;
+        };
+        let steps: Vec<StepDef> = [
+            self.write(Role::Setup, isdu::LOCKS, 1),
+            self.write(Role::Check, jog, max),
+            self.read(jog),
+            self.write(Role::Check, isdu::LOCKS, 0),
+            self.write(Role::Check, jog, max),
+            self.read(jog),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.case(
+            "isdu/write-lock",
+            &["PSX-DP-ERR-008", "PSX-ISDU-12-BITS"],
+            "with ISDU 12 bit 0 set a parameter write is refused; ISDU 12 stays writable",
+            steps,
+        );
+    }
+
+    // ------------------------------------------------------------------ guard
+
+    fn guard_cases(&mut self) {
+        let guards = match Guards::from_rules(self.rules, &Readings::default()) {
+            Ok(g) => g,
+            Err(e) => {
+                self.errors.push(format!("guard entries: {e}"));
+                return;
+            }
+        };
+        let other = isdu::PROBE;
+        for g in guards.guards().to_vec() {
+            let prefix = g
+                .requirement
+                .strip_suffix("-SUPPRESS")
+                .unwrap_or(&g.requirement)
+                .to_owned();
+            let allow_req = format!("{prefix}-ALLOW");
+            let volatile_req = format!("{prefix}-VOLATILE");
+            let new = self.value(&g.guarded).saturating_add(4);
+            let allow_value = g.allow.unwrap_or(1);
+            let suppress: Vec<StepDef> = [
+                self.read(&g.guarded),
+                self.write(Role::Check, &g.guard, g.suppress),
+                self.write(Role::Check, &g.guarded, new),
+                self.read(&g.guarded),
+                Some(step(Role::Check, "two cycles", Action::Hold(2))),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.case(
+                &format!("guard/{}/suppress", g.guard),
+                &[&g.requirement, "PSX-GUARD-ONESHOT"],
+                &format!(
+                    "ISDU {} = {} drops the directly following write of ISDU {}",
+                    g.guard, g.suppress, g.guarded
+                ),
+                suppress,
+            );
+            let allow: Vec<StepDef> = [
+                self.write(Role::Check, &g.guarded, new),
+                self.read(&g.guarded),
+                Some(step(Role::Check, "two cycles", Action::Hold(2))),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.case(
+                &format!("guard/{}/allow", g.guard),
+                &[&allow_req],
+                &format!(
+                    "a write of ISDU {} without ISDU {} = {} before it is executed",
+                    g.guarded, g.guard, g.suppress
+                ),
+                allow,
+            );
+            let allowed_value: Vec<StepDef> = [
+                self.write(Role::Check, &g.guard, allow_value),
+                self.write(Role::Check, &g.guarded, new),
+                self.read(&g.guarded),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.case(
+                &format!("guard/{}/allow-value", g.guard),
+                &[&allow_req],
+                &format!(
+                    "ISDU {} = {allow_value} lets the following write of ISDU {} through",
+                    g.guard, g.guarded
+                ),
+                allowed_value,
+            );
+            let other_value = self.value(other).saturating_add(1);
+            let oneshot: Vec<StepDef> = [
+                self.write(Role::Check, &g.guard, g.suppress),
+                self.write(Role::Check, other, other_value),
+                self.write(Role::Check, &g.guarded, new),
+                self.read(&g.guarded),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.case(
+                &format!("guard/{}/one-shot", g.guard),
+                &["PSX-GUARD-ONESHOT", &allow_req],
+                &format!(
+                    "another write between ISDU {} = {} and ISDU {} ends the suppression",
+                    g.guard, g.suppress, g.guarded
+                ),
+                oneshot,
+            );
+            let volatile: Vec<StepDef> = [
+                self.read(&g.guard),
+                self.write(Role::Check, &g.guard, allow_value),
+                self.save(Role::Check),
+                Some(step(
+                    Role::Check,
+                    "saving",
+                    Action::Hold(self.cycles_for(self.save_ms())),
+                )),
+                Some(step(
+                    Role::Check,
+                    "power cycle",
+                    Action::Env(Env::PowerCycle),
+                )),
+                self.read(&g.guard),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.case(
+                &format!("guard/{}/volatile", g.guard),
+                &[&volatile_req, "PSX-PAR-NOT-SAVED"],
+                &format!(
+                    "ISDU {} is delivered as its delivery value after a save and a power cycle",
+                    g.guard
+                ),
+                volatile,
+            );
+        }
+    }
+
+    /// The write that saves the working values (ISDU 193 = 1, PSX-CMD-014), from the spec's
+    /// command table.
+    fn save(&mut self, role: Role) -> Option<StepDef> {
+        let value = self
+            .rules
+            .protocol()
+            .commands
+            .commands
+            .iter()
+            .find(|c| c.param == isdu::DELIVERY_STATE && c.save && !c.defaults)
+            .map(|c| c.value);
+        let Some(value) = value else {
+            self.errors
+                .push("no save command of ISDU 193 in the command table".to_owned());
+            return None;
+        };
+        self.write(role, isdu::DELIVERY_STATE, value)
+    }
+
+    fn save_ms(&self) -> u64 {
+        u64::from(self.rules.protocol().commands.save_max_ms)
+    }
+
+    // ------------------------------------------------------------------ command
+
+    fn command_cases(&mut self) {
+        let probe = isdu::PROBE;
+        let Some(p) = self.param(probe) else {
+            return;
+        };
+        let Some(probe_value) = self.range(p).and_then(|r| r.last().map(|i| i[1])) else {
+            return;
+        };
+        let format_param = self.rules.protocol().format_select.param.clone();
+        let commands = self.rules.protocol().commands.commands.clone();
+        let save_cycles = self.cycles_for(self.save_ms());
+        for c in &commands {
+            let mut reqs = self.reqs_of(&c.param);
+            reqs.extend(["PSX-PAR-SAVED", "PSX-DP-007"].map(str::to_owned));
+            let mut steps: Vec<StepDef> = [
+                self.write(Role::Setup, probe, probe_value),
+                self.write(Role::Setup, &format_param, 0),
+                self.write(Role::Check, &c.param, c.value),
+                Some(step(
+                    Role::Check,
+                    "saving or running",
+                    Action::Hold(save_cycles),
+                )),
+                Some(step(
+                    Role::Check,
+                    "until standstill",
+                    Action::Until {
+                        running: false,
+                        max: RUN_MAX,
+                    },
+                )),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            let readable = self
+                .family
+                .parameters
+                .iter()
+                .any(|p| p.id == c.param && p.access.readable());
+            if readable {
+                steps.extend(self.read(&c.param));
+            }
+            steps.extend(
+                [
+                    self.read(probe),
+                    self.read(&format_param),
+                    Some(step(
+                        Role::Check,
+                        "power cycle",
+                        Action::Env(Env::PowerCycle),
+                    )),
+                    self.read(probe),
+                    self.read(&format_param),
+                ]
+                .into_iter()
+                .flatten(),
+            );
+            steps.extend(self.device_id_reads());
+            let reqs: Vec<&str> = reqs.iter().map(String::as_str).collect();
+            self.case(
+                &format!("command/{}/{}", c.param, c.name),
+                &reqs,
+                &format!(
+                    "ISDU {} = {} ({}): {}; working and saved values across a power cycle",
+                    c.param, c.value, c.name, c.meaning
+                ),
+                steps,
+            );
+        }
+        // Values that are not commands: 0, the type's top, one above each command and one
+        // beyond each end of ISDU 193's range.
+        let standard: Vec<i64> = commands
+            .iter()
+            .filter(|c| c.param == isdu::STANDARD_COMMAND)
+            .map(|c| c.value)
+            .collect();
+        let mut not_commands: Vec<i64> = vec![0, i64::from(u8::MAX)];
+        for v in &standard {
+            let next = v.saturating_add(1);
+            if !standard.contains(&next) && !not_commands.contains(&next) {
+                not_commands.push(next);
+            }
+        }
+        not_commands.sort_unstable();
+        let states: Vec<i64> = commands
+            .iter()
+            .filter(|c| c.param == isdu::DELIVERY_STATE)
+            .map(|c| c.value)
+            .collect();
+        let (lo, hi) = (
+            states.iter().min().copied().unwrap_or(0),
+            states.iter().max().copied().unwrap_or(0),
+        );
+        for (param, values, reqs) in [
+            (isdu::STANDARD_COMMAND, not_commands, vec!["PSX-DP-ERR-005"]),
+            (
+                isdu::DELIVERY_STATE,
+                vec![lo.saturating_sub(1), hi.saturating_add(1)],
+                vec!["PSX-ISDU-193-RANGE", "PSX-DP-ERR-004"],
+            ),
+        ] {
+            for v in values {
+                let steps: Vec<StepDef> = [
+                    self.write(Role::Check, param, v),
+                    Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                ]
+                .into_iter()
+                .flatten()
+                .collect();
+                self.case(
+                    &format!("command/{param}/invalid-{v}"),
+                    &reqs,
+                    &format!("ISDU {param} = {v} is no command: refused"),
+                    steps,
+                );
+            }
+        }
+        // Working values are lost in a power cycle unless saved.
+        let lost: Vec<StepDef> = [
+            self.write(Role::Check, probe, probe_value),
+            self.read(probe),
+            Some(step(
+                Role::Check,
+                "power cycle",
+                Action::Env(Env::PowerCycle),
+            )),
+            self.read(probe),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.case(
+            "command/unsaved-lost",
+            &["PSX-CMD-018", "PSX-PAR-SAVED"],
+            "a written value without a save is lost in a power cycle",
+            lost,
+        );
+        let kept: Vec<StepDef> = [
+            self.write(Role::Check, probe, probe_value),
+            self.save(Role::Check),
+            self.read(isdu::DELIVERY_STATE),
+            Some(step(Role::Check, "saving", Action::Hold(save_cycles))),
+            self.read(isdu::DELIVERY_STATE),
+            Some(step(
+                Role::Check,
+                "power cycle",
+                Action::Env(Env::PowerCycle),
+            )),
+            self.read(probe),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.case(
+            "command/saved-kept",
+            &["PSX-CMD-018", "PSX-PAR-SAVED", "PSX-CMD-014", "PSX-CMD-017"],
+            "a value saved with ISDU 193 = 1 survives a power cycle",
+            kept,
+        );
+        // Entries that are never saved.
+        let params: Vec<&Parameter> = self.family.parameters.iter().collect();
+        for p in params {
+            if p.saved != Some(false) || !p.access.writable() || p.id == isdu::DELIVERY_STATE {
+                continue;
+            }
+            // The top of a declared range, else a small step from the delivery value (a
+            // control word of transfer bit 2 only).
+            let declared = p.range.is_some() || p.range_model;
+            let top = self.range(p).and_then(|r| r.last().map(|i| i[1]));
+            let Some(v) = top
+                .filter(|_| declared)
+                .or_else(|| self.default_of(p).map(|d| d.saturating_add(4)))
+            else {
+                continue;
+            };
+            let steps: Vec<StepDef> = [
+                self.write(Role::Check, &p.id, v),
+                self.save(Role::Check),
+                Some(step(Role::Check, "saving", Action::Hold(save_cycles))),
+                Some(step(
+                    Role::Check,
+                    "power cycle",
+                    Action::Env(Env::PowerCycle),
+                )),
+                self.read(&p.id),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.case(
+                &format!("command/not-saved/{}", p.id),
+                &["PSX-PAR-NOT-SAVED"],
+                &format!(
+                    "ISDU {} ({}) is not saved: after a save and a power cycle it holds its delivery value",
+                    p.id, p.name
+                ),
+                steps,
+            );
+        }
+    }
+
+    /// Reads of the DeviceID octets of Direct Parameter page 1 (ISDU 0; PSX-DP-007).
+    fn device_id_reads(&self) -> Vec<StepDef> {
+        let dp = &self.rules.protocol().direct_parameters;
+        dp.entries
+            .iter()
+            .filter(|e| e.name.starts_with("DeviceID"))
+            .filter_map(|e| {
+                let subindex = e.address.checked_add(dp.subindex_offset)?;
+                Some(step(
+                    Role::Check,
+                    format!("ISDU read {}.{subindex} ({})", dp.isdu_index, e.name),
+                    Action::Isdu(Request::Read {
+                        index: dp.isdu_index,
+                        subindex,
+                    }),
+                ))
+            })
+            .collect()
+    }
+
+    // ------------------------------------------------------------------ format
+
+    /// Steps that make `format` the active one: write, save, device reset (PSX-PD-010).
+    fn switch_to(&mut self, format: u8, role: Role) -> Vec<StepDef> {
+        let param = self.rules.protocol().format_select.param.clone();
+        let save_cycles = self.cycles_for(self.save_ms());
+        let reset = self
+            .rules
+            .protocol()
+            .commands
+            .commands
+            .iter()
+            .find(|c| c.reset && !c.defaults && !c.save)
+            .map(|c| (c.param.clone(), c.value));
+        let Some((reset_param, reset_value)) = reset else {
+            self.errors.push("no device-reset command".to_owned());
+            return Vec::new();
+        };
+        let mut steps: Vec<StepDef> = [
+            self.write(role, &param, i64::from(format)),
+            self.save(role),
+            Some(step(role, "saving", Action::Hold(save_cycles))),
+            self.write(role, &reset_param, reset_value),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        steps.push(step(
+            role,
+            format!("format {format} idle output"),
+            Action::Out(self.idle(format)),
+        ));
+        steps
+    }
+
+    fn format_cases(&mut self) {
+        let param = self.rules.protocol().format_select.param.clone();
+        let formats: Vec<u8> = self.rules.outputs().iter().map(|o| o.format).collect();
+        let start = self.value(isdu::ACTUAL);
+        for &f in &formats {
+            let mut steps = self.device_id_reads();
+            steps.extend(self.write(Role::Check, &param, i64::from(f)));
+            steps.extend(self.read(&param));
+            steps.push(step(
+                Role::Check,
+                "cycles in the old format",
+                Action::Hold(2),
+            ));
+            steps.extend(self.device_id_reads());
+            steps.extend(self.switch_to(f, Role::Check));
+            steps.push(step(
+                Role::Check,
+                "cycles in the new format",
+                Action::Hold(2),
+            ));
+            steps.extend(self.device_id_reads());
+            let mut reqs = vec![
+                "PSX-PD-001",
+                "PSX-PD-010",
+                "PSX-DP-005",
+                "PSX-DP-007",
+                "PSX-DP-008",
+                "PSX-PD-007",
+            ];
+            if f == 2 {
+                reqs.push("PSX-PD-005");
+            }
+            self.case(
+                &format!("format/{f}/switch"),
+                &reqs,
+                &format!(
+                    "ISDU 116 = {f} takes effect, with its device ID, only after a save and a device reset"
+                ),
+                steps,
+            );
+            let unsaved: Vec<StepDef> = [
+                self.write(Role::Check, &param, i64::from(f)),
+                Some(step(
+                    Role::Check,
+                    "power cycle",
+                    Action::Env(Env::PowerCycle),
+                )),
+                self.read(&param),
+                Some(step(Role::Check, "cycles in format 1", Action::Hold(2))),
+            ]
+            .into_iter()
+            .flatten()
+            .chain(self.device_id_reads())
+            .collect();
+            self.case(
+                &format!("format/{f}/unsaved"),
+                &["PSX-PD-010", "PSX-CMD-018", "PSX-DP-008"],
+                &format!("ISDU 116 = {f} without a save is lost in a power cycle"),
+                unsaved,
+            );
+        }
+        // A positioning run in every format.
+        let transfer = self.control("release-and-transfer");
+        let target = start.saturating_add(4000);
+        let f1 = vec![
+            step(Role::Check, "0x14 to start+4000", self.f1(transfer, target)),
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ];
+        self.motion(
+            "format/1/positioning",
+            &["PSX-PD-003", "PSX-CMD-001", "PSX-STS-0-SET-1"],
+            "format 1: control word 0x14 and a target start a positioning run",
+            f1,
+        );
+        let mut f2 = self.switch_to(2, Role::Setup);
+        f2.extend([
+            step(
+                Role::Check,
+                "speed 0, 0x14 to start+4000",
+                self.f2(0, transfer, target),
+            ),
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        self.motion(
+            "format/2/speed-zero",
+            &["PSX-PD-004", "PSX-VEL-006", "PSX-VEL-001", "PSX-CMD-001"],
+            "format 2: speed 0 in the process data runs at ISDU 142",
+            f2,
+        );
+        self.speed_cases(start, transfer);
+        let mut f0 = self.switch_to(0, Role::Setup);
+        f0.extend(self.stamp_run(target, 3, 10_000));
+        self.motion(
+            "format/0/positioning",
+            &["PSX-PD-002", "PSX-PD-011", "PSX-TS-010"],
+            "format 0: a target through ISDU 112 and control code 3 with a time stamp",
+            f0,
+        );
+    }
+
+    /// The 8-byte format's speed rules (manual 3.3.1; PSX-VEL-005..008).
+    fn speed_cases(&mut self, start: i64, transfer: u16) {
+        let positioning = self.rules.protocol().target_speed.positioning_param.clone();
+        let Some(p) = self.param(&positioning) else {
+            return;
+        };
+        let Some(intervals) = self.range(p) else {
+            return;
+        };
+        let (Some(lo), Some(hi)) = (
+            intervals.first().map(|i| i[0]),
+            intervals.last().map(|i| i[1]),
+        ) else {
+            return;
+        };
+        let mid = (lo + hi) / 2;
+        let low = i16::try_from(lo.max(1)).unwrap_or(1);
+        let fast = i16::try_from(mid).unwrap_or(1);
+        let target = start.saturating_add(8000);
+        let mut given = self.switch_to(2, Role::Setup);
+        given.extend(
+            [
+                Some(step(
+                    Role::Check,
+                    format!("speed {low}, 0x14 to start+8000"),
+                    self.f2(low, transfer, target),
+                )),
+                Some(step(Role::Check, "until running", Self::until(true))),
+                Some(step(Role::Check, "running", Action::Hold(20))),
+                Some(step(
+                    Role::Check,
+                    format!("speed {fast} during the run"),
+                    self.f2(fast, transfer, target),
+                )),
+                Some(step(Role::Check, "until standstill", Self::until(false))),
+                self.read(&positioning),
+            ]
+            .into_iter()
+            .flatten(),
+        );
+        self.motion(
+            "format/2/speed-given",
+            &["PSX-VEL-005", "PSX-VEL-008", "PSX-PD-004"],
+            "format 2: the process-data speed is used instead of ISDU 142, also when changed during a run; ISDU 142 stays",
+            given,
+        );
+        let bad = i16::try_from(hi.saturating_add(1)).unwrap_or(i16::MAX);
+        let mut invalid = self.switch_to(2, Role::Setup);
+        invalid.extend([
+            step(
+                Role::Check,
+                format!("speed {bad} (above the range), 0x14 to start+8000"),
+                self.f2(bad, transfer, target),
+            ),
+            step(Role::Check, "no run", Action::Hold(10)),
+            step(
+                Role::Check,
+                format!("speed {fast}: the run starts"),
+                self.f2(fast, transfer, target),
+            ),
+            step(Role::Check, "until running", Self::until(true)),
+            step(
+                Role::Check,
+                format!("speed {bad} during the run: aborted"),
+                self.f2(bad, transfer, target),
+            ),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        self.motion(
+            "format/2/speed-invalid",
+            &["PSX-VEL-007", "PSX-STS-12-SET-2"],
+            "format 2: an invalid speed starts no run, aborts a running one and sets status bit 12",
+            invalid,
+        );
+        let manual = self.control("release-manual-run-larger");
+        let release = self.control("release");
+        let mut man = self.switch_to(2, Role::Setup);
+        man.extend([
+            step(
+                Role::Check,
+                format!("0x11 with speed {low}"),
+                self.f2(low, manual, 0),
+            ),
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "manual run", Action::Hold(25)),
+            step(Role::Check, "0x10: stop", self.f2(low, release, 0)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        self.motion(
+            "format/2/manual",
+            &["PSX-CMD-019", "PSX-VEL-005"],
+            "format 2: a manual run with 0x11 runs at the process-data speed",
+            man,
+        );
+    }
+
+    // ------------------------------------------------------------------ timestamp
+
+    /// The time-stamp positioning sequence of 4.4 (PSX-TS-010).
+    fn stamp_run(&mut self, target: i64, code: u8, stamp: u16) -> Vec<StepDef> {
+        let target_param = self.rules.timestamp().target_param.clone();
+        let inactive = self.inactive();
+        let mut steps = vec![step(Role::Check, "stamp inactive", self.f0(0, inactive))];
+        if code == 3 {
+            steps.extend(self.write(Role::Check, &target_param, target));
+        }
+        steps.extend([
+            step(
+                Role::Check,
+                format!("code {code}, stamp {stamp}"),
+                self.f0(code, Stamp(stamp)),
+            ),
+            step(Role::Check, "stamp inactive", self.f0(code, inactive)),
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        steps
+    }
+
+    fn timestamp_cases(&mut self) {
+        let ts = self.rules.timestamp().clone();
+        let start = self.value(isdu::ACTUAL);
+        let target = start.saturating_add(3000);
+        let inactive = self.inactive();
+        let target_param = ts.target_param.clone();
+        let cw_param = ts.control_word_param.clone();
+        let edges = [
+            ("max-valid", ts.max_valid, vec!["PSX-TS-003", "PSX-TS-001"]),
+            (
+                "last-immediate",
+                ts.immediate_below.saturating_sub(1),
+                vec!["PSX-TS-006"],
+            ),
+            (
+                "first-delayed",
+                ts.immediate_below,
+                vec!["PSX-TS-006", "PSX-TS-001"],
+            ),
+            ("zero", 0, vec!["PSX-TS-006"]),
+        ];
+        for (name, stamp, reqs) in edges {
+            let mut steps = self.switch_to(0, Role::Setup);
+            steps.extend(self.stamp_run(target, 3, u16::try_from(stamp).unwrap_or(0)));
+            self.motion(
+                &format!("timestamp/edge/{name}"),
+                &reqs,
+                &format!("time stamp {stamp} with control code 3 (stamp inactive after it)"),
+                steps,
+            );
+        }
+        let mut steps = self.switch_to(0, Role::Setup);
+        steps.extend(self.stamp_run(target, 3, 10_000));
+        self.motion(
+            "timestamp/position",
+            &["PSX-TS-010", "PSX-TS-005", "PSX-TS-008", "PSX-TS-001"],
+            "positioning by time stamp: executed the stamp's delay after the field turns inactive",
+            steps,
+        );
+        let mut steps = self.switch_to(0, Role::Setup);
+        steps.push(step(Role::Check, "stamp inactive", self.f0(0, inactive)));
+        steps.extend(self.write(Role::Check, &target_param, target));
+        steps.extend([
+            step(Role::Check, "code 3, stamp 2500", self.f0(3, Stamp(2500))),
+            step(
+                Role::Check,
+                "the valid stamp repeated: nothing runs",
+                Action::Hold(30),
+            ),
+            step(Role::Check, "code 3, stamp 3000", self.f0(3, Stamp(3000))),
+            step(Role::Check, "still nothing", Action::Hold(10)),
+            step(Role::Check, "stamp inactive", self.f0(3, inactive)),
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        self.motion(
+            "timestamp/not-while-active",
+            &["PSX-TS-004", "PSX-TS-005"],
+            "a valid stamp sent cyclically causes no action; the last one runs after the field turns inactive",
+            steps,
+        );
+        for (code, name) in [(1u8, "forward"), (2, "reverse")] {
+            let mut steps = self.switch_to(0, Role::Setup);
+            steps.extend([
+                step(Role::Check, "stamp inactive", self.f0(0, inactive)),
+                step(
+                    Role::Check,
+                    format!("code {code}, stamp 5000"),
+                    self.f0(code, Stamp(5000)),
+                ),
+                step(Role::Check, "stamp inactive", self.f0(code, inactive)),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "manual run", Action::Hold(25)),
+                step(Role::Check, "code 0, stamp 0: cancel", self.f0(0, Stamp(0))),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ]);
+            self.motion(
+                &format!("timestamp/manual-{name}"),
+                &["PSX-TS-011", "PSX-TS-007", "PSX-PD-011"],
+                &format!("a manual run {name} by time stamp, cancelled by code 0 with stamp 0"),
+                steps,
+            );
+        }
+        let no_loop = self.control("run-without-loop");
+        let back = start.saturating_sub(3000);
+        let mut steps = self.switch_to(0, Role::Setup);
+        steps.extend(self.write(Role::Check, &cw_param, i64::from(no_loop)));
+        steps.extend(self.stamp_run(back, 3, 5000));
+        self.motion(
+            "timestamp/without-loop",
+            &["PSX-TS-012", "PSX-PD-012", "PSX-RUN-007"],
+            "control bit 6 set through ISDU 110, then a time-stamp positioning against the loop direction runs without loop",
+            steps,
+        );
+        let release = self.control("release");
+        let mut steps = self.switch_to(0, Role::Setup);
+        steps.push(step(Role::Check, "stamp inactive", self.f0(0, inactive)));
+        steps.extend(self.write(Role::Check, &cw_param, i64::from(release)));
+        steps.extend(self.write(Role::Check, &target_param, target));
+        steps.extend([
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        self.motion(
+            "timestamp/isdu-control",
+            &["PSX-PD-013", "PSX-CMD-009"],
+            "with the stamp inactive, ISDU 110 = 0x10 and a target in ISDU 112 start a run",
+            steps,
+        );
+    }
+
+    // ------------------------------------------------------------------ status
+
+    fn status_cases(&mut self) {
+        let start = self.value(isdu::ACTUAL);
+        let transfer = self.control("release-and-transfer");
+        let release = self.control("release");
+        let clear = self.control_bit("Clear error bits");
+        let manual_down = self.control("release-manual-run-smaller");
+        self.motion(
+            "status/power-on",
+            &["PSX-STS-LAYOUT", "PSX-STS-4-SET-1"],
+            "status word after power-on",
+            vec![step(Role::Check, "three cycles", Action::Hold(3))],
+        );
+        self.motion(
+            "status/target-reached",
+            &[
+                "PSX-STS-0-SET-1",
+                "PSX-STS-6-SET-1",
+                "PSX-STS-6-RESET-1",
+                "PSX-STS-0-RESET-1",
+            ],
+            "bit 6 while running, bit 0 at the target, bit 0 cleared by a new target",
+            vec![
+                step(
+                    Role::Check,
+                    "0x14 to start+2000",
+                    self.f1(transfer, start + 2000),
+                ),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "until standstill", Self::until(false)),
+                step(Role::Check, "0x14 to start", self.f1(transfer, start)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "status/release-withdrawn",
+            &[
+                "PSX-STS-5-SET-1",
+                "PSX-CMD-002",
+                "PSX-CTL-4-3",
+                "PSX-CTL-14-1",
+                "PSX-STS-5-RESET-2",
+            ],
+            "withdrawing the release cancels the run and sets bit 5; a bit 14 edge clears it",
+            vec![
+                step(
+                    Role::Check,
+                    "0x14 to start+20000",
+                    self.f1(transfer, start + 20_000),
+                ),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "running", Action::Hold(10)),
+                step(Role::Check, "0x00", self.f1(0, start + 20_000)),
+                step(Role::Check, "until standstill", Self::until(false)),
+                step(Role::Check, "bit 14 set", self.f1(clear, start + 20_000)),
+                step(Role::Check, "held", Action::Hold(3)),
+            ],
+        );
+        let umot = self.value(isdu::UMOT_LIMIT);
+        self.motion(
+            "status/motor-voltage",
+            &[
+                "PSX-STS-4-RESET-1",
+                "PSX-STS-13-SET-1",
+                "PSX-STS-4-SET-1",
+                "PSX-ISDU-181-BIT4",
+            ],
+            "motor voltage below ISDU 181: bit 4 cleared, a positioning order sets bit 13",
+            vec![
+                step(
+                    Role::Check,
+                    format!("motor voltage {} (0.1 V)", umot - 10),
+                    Action::Env(Env::MotorVoltage(u16::try_from(umot - 10).unwrap_or(0))),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(
+                    Role::Check,
+                    "0x14 to start+2000",
+                    self.f1(transfer, start + 2000),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(
+                    Role::Check,
+                    "motor voltage 240",
+                    Action::Env(Env::MotorVoltage(240)),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+            ],
+        );
+        let tmax = self.value(isdu::TEMPERATURE_LIMIT);
+        self.motion(
+            "status/temperature",
+            &["PSX-STS-7-SET-1", "PSX-STS-7-RESET-1", "PSX-ISDU-182-BIT7"],
+            "temperature above ISDU 182 sets bit 7; 5 °C below it clears it",
+            vec![
+                step(
+                    Role::Check,
+                    format!("temperature {} °C", tmax + 1),
+                    Action::Env(Env::Temperature(i16::try_from(tmax + 1).unwrap_or(0))),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(
+                    Role::Check,
+                    format!("temperature {} °C", tmax - 6),
+                    Action::Env(Env::Temperature(i16::try_from(tmax - 6).unwrap_or(0))),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+            ],
+        );
+        let window = self.value(isdu::WINDOW);
+        self.motion(
+            "status/displaced",
+            &["PSX-STS-11-SET-1", "PSX-STS-11-RESET-1", "PSX-ISDU-131-WINDOW"],
+            "turned by hand at standstill by more than ISDU 131: bit 11; a positioning order clears it",
+            vec![
+                step(Role::Check, "0x14 to start+2000", self.f1(transfer, start + 2000)),
+                step(Role::Check, "until standstill", Self::until(false)),
+                step(
+                    Role::Check,
+                    format!("displaced by {}", window + 50),
+                    Action::Env(Env::Displace(window + 50)),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "0x14 to start", self.f1(transfer, start)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        let upper = self.value(isdu::UPPER_LIMIT);
+        self.motion(
+            "status/target-outside",
+            &["PSX-STS-12-SET-1", "PSX-STS-12-RESET-1"],
+            "a target above ISDU 129 is refused with bit 12; a valid one clears it",
+            vec![
+                step(
+                    Role::Check,
+                    "0x14 to ISDU 129 + 10",
+                    self.f1(transfer, upper + 10),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "0x10", self.f1(release, upper + 10)),
+                step(
+                    Role::Check,
+                    "0x14 to start+1000",
+                    self.f1(transfer, start + 1000),
+                ),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "status/manual-against-loop",
+            &["PSX-STS-8-SET-1", "PSX-CTL-1-1", "PSX-CMD-006"],
+            "a manual run against the loop direction sets bit 8",
+            vec![
+                step(Role::Check, "0x12", self.f1(manual_down, start)),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "manual run", Action::Hold(20)),
+                step(Role::Check, "0x10: stop", self.f1(release, start)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "status/jog-keys",
+            &[
+                "PSX-STS-2-SET-1",
+                "PSX-STS-2-RESET-1",
+                "PSX-STS-3-SET-1",
+                "PSX-STS-3-RESET-1",
+            ],
+            "status bits 3 and 2 follow the forward and reverse jog keys",
+            vec![
+                step(
+                    Role::Check,
+                    "forward key",
+                    Action::Env(Env::Keys {
+                        forward: true,
+                        reverse: false,
+                    }),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(
+                    Role::Check,
+                    "both keys",
+                    Action::Env(Env::Keys {
+                        forward: true,
+                        reverse: true,
+                    }),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(
+                    Role::Check,
+                    "reverse key",
+                    Action::Env(Env::Keys {
+                        forward: false,
+                        reverse: true,
+                    }),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(
+                    Role::Check,
+                    "no key",
+                    Action::Env(Env::Keys {
+                        forward: false,
+                        reverse: false,
+                    }),
+                ),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "status/obstruction",
+            &["PSX-STS-10-SET-1", "PSX-STS-10-RESET-1"],
+            "a jammed shaft during a run cancels it with bit 10; a new positioning order clears it",
+            vec![
+                step(
+                    Role::Check,
+                    "0x14 to start+20000",
+                    self.f1(transfer, start + 20_000),
+                ),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "jam", Action::Env(Env::Jam(true))),
+                step(Role::Check, "until standstill", Self::until(false)),
+                step(Role::Check, "cycles", Action::Hold(40)),
+                step(Role::Check, "free", Action::Env(Env::Jam(false))),
+                step(Role::Check, "0x10", self.f1(release, start)),
+                step(Role::Check, "0x14 to start", self.f1(transfer, start)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "status/position-fault",
+            &["PSX-STS-9-SET-1"],
+            "an internal position fault sets bit 9",
+            vec![
+                step(Role::Check, "cycles", Action::Hold(2)),
+                step(
+                    Role::Check,
+                    "position fault",
+                    Action::Env(Env::PositionFault),
+                ),
+                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+            ],
+        );
+        // Manual runs to narrowed end limits (ISDU 129 / 130): bits 14 and 15.
+        let up = self.control("release-manual-run-larger");
+        for (limit, offset, word, bit, name) in [
+            (isdu::UPPER_LIMIT, 600i64, up, "14", "upper"),
+            (isdu::LOWER_LIMIT, -600, manual_down, "15", "lower"),
+        ] {
+            let steps: Vec<StepDef> = [
+                self.write(Role::Setup, limit, start + offset),
+                Some(step(
+                    Role::Check,
+                    format!("{word:#06x}: manual run"),
+                    self.f1(word, start),
+                )),
+                Some(step(Role::Check, "until running", Self::until(true))),
+                Some(step(Role::Check, "until standstill", Self::until(false))),
+                Some(step(Role::Check, "held at the limit", Action::Hold(SETTLE))),
+                Some(step(
+                    Role::Check,
+                    "0x14 to start: bit cleared",
+                    self.f1(transfer, start),
+                )),
+                Some(step(Role::Check, "until standstill", Self::until(false))),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            let set = format!("PSX-STS-{bit}-SET-1");
+            let reset = format!("PSX-STS-{bit}-RESET-1");
+            self.motion(
+                &format!("status/{name}-limit"),
+                &[&set, &reset, "PSX-JOG-008"],
+                &format!(
+                    "a manual run stops at the {name} limit ISDU {limit} with bit {bit}; a positioning run clears it"
+                ),
+                steps,
+            );
+        }
+    }
+
+    // ------------------------------------------------------------------ timeout
+
+    fn timeout_cases(&mut self) {
+        let t = self.rules.protocol().timeout.clone();
+        let start = self.value(isdu::ACTUAL);
+        let transfer = self.control("release-and-transfer");
+        let far = start + 40_000;
+        let silence = 300_000;
+        let release = self.control("release");
+        let off: Vec<StepDef> = [
+            Some(step(
+                Role::Check,
+                "0x14 to start+40000",
+                self.f1(transfer, far),
+            )),
+            Some(step(Role::Check, "until running", Self::until(true))),
+            Some(step(
+                Role::Check,
+                "connection lost",
+                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
+            )),
+            Some(step(
+                Role::Check,
+                "silence 300 ms",
+                Action::Silence(silence),
+            )),
+            self.read(isdu::ACTUAL),
+            Some(step(
+                Role::Check,
+                "connected",
+                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
+            )),
+            Some(step(Role::Check, "until standstill", Self::until(false))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.motion(
+            "timeout/off",
+            &["PSX-TIMEOUT-001", "PSX-TIMEOUT-002", "PSX-TIMEOUT-006"],
+            "ISDU 118 = 0: a run goes on while the connection is lost",
+            off,
+        );
+        for (config, name, reqs) in [
+            (1i64, "cancel", vec!["PSX-TIMEOUT-003", "PSX-TIMEOUT-004"]),
+            (
+                2,
+                "safe-position",
+                vec!["PSX-TIMEOUT-003", "PSX-TIMEOUT-005"],
+            ),
+        ] {
+            let steps: Vec<StepDef> = [
+                self.write(Role::Setup, &t.timeout_param, 100),
+                self.write(Role::Setup, &t.config_param, config),
+                self.write(Role::Setup, &t.safe_position_param, start - 5000),
+                Some(step(
+                    Role::Check,
+                    "0x14 to start+40000",
+                    self.f1(transfer, far),
+                )),
+                Some(step(Role::Check, "until running", Self::until(true))),
+                Some(step(
+                    Role::Check,
+                    "kept alive: cycles for 200 ms",
+                    Action::Hold(self.cycles_for(200)),
+                )),
+                Some(step(
+                    Role::Check,
+                    "silence 300 ms",
+                    Action::Silence(silence),
+                )),
+                self.read(isdu::STATUS),
+                Some(step(
+                    Role::Check,
+                    "silence 10 s",
+                    Action::Silence(10_000_000),
+                )),
+                self.read(isdu::STATUS),
+                self.read(isdu::ACTUAL),
+                Some(step(Role::Check, "0x10", self.f1(release, far))),
+                Some(step(Role::Check, "until standstill", Self::until(false))),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            self.motion(
+                &format!("timeout/{name}"),
+                &reqs,
+                &format!(
+                    "ISDU 118 = 100 ms, ISDU 137 = {config}: the master falls silent during a run"
+                ),
+                steps,
+            );
+        }
+        let reserved: Vec<StepDef> = [
+            self.write(Role::Check, &t.config_param, 0),
+            self.read(&t.config_param),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.case(
+            "timeout/reserved",
+            &["PSX-TIMEOUT-007", "PSX-ISDU-137-RANGE"],
+            "ISDU 137 = 0 is reserved: refused",
+            reserved,
+        );
+    }
+
+    // ------------------------------------------------------------------ position
+
+    fn position_cases(&mut self) {
+        let start = self.value(isdu::ACTUAL);
+        let transfer = self.control("release-and-transfer");
+        let without = self.control("run-without-loop");
+        let release = self.control("release");
+        let up = self.control("release-manual-run-larger");
+        let only_transfer = self.control("transfer-without-release");
+        for (name, offset, cw, reqs) in [
+            (
+                "loop-up",
+                5000i64,
+                transfer,
+                vec!["PSX-RUN-001", "PSX-RUN-002", "PSX-CMD-001"],
+            ),
+            (
+                "loop-down",
+                -5000,
+                transfer,
+                vec!["PSX-RUN-001", "PSX-RUN-003", "PSX-CMD-001"],
+            ),
+            (
+                "no-loop-down",
+                -5000,
+                transfer | without,
+                vec!["PSX-RUN-007", "PSX-CMD-008"],
+            ),
+            (
+                "no-loop-up",
+                5000,
+                transfer | without,
+                vec!["PSX-RUN-007", "PSX-CMD-008"],
+            ),
+        ] {
+            self.motion(
+                &format!("position/{name}"),
+                &reqs,
+                &format!("positioning by {offset} steps with control word {cw:#06x}"),
+                vec![
+                    step(
+                        Role::Check,
+                        format!("{cw:#06x} to start{offset:+}"),
+                        self.f1(cw, start + offset),
+                    ),
+                    step(Role::Check, "until running", Self::until(true)),
+                    step(Role::Check, "until standstill", Self::until(false)),
+                ],
+            );
+        }
+        self.motion(
+            "position/new-target",
+            &["PSX-CMD-003"],
+            "a new target during a run is approached at once",
+            vec![
+                step(
+                    Role::Check,
+                    "0x14 to start+20000",
+                    self.f1(transfer, start + 20_000),
+                ),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "running", Action::Hold(20)),
+                step(
+                    Role::Check,
+                    "0x14 to start+10000",
+                    self.f1(transfer, start + 10_000),
+                ),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "position/transfer-then-release",
+            &["PSX-CMD-005", "PSX-CMD-010", "PSX-CTL-2-1"],
+            "a target transferred without release starts when release is set",
+            vec![
+                step(
+                    Role::Check,
+                    "0x04 to start+3000",
+                    self.f1(only_transfer, start + 3000),
+                ),
+                step(Role::Check, "no run", Action::Hold(10)),
+                step(Role::Check, "0x10", self.f1(release, start + 3000)),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "position/manual",
+            &["PSX-CMD-006", "PSX-CTL-0-1"],
+            "0x11 runs to larger values until 0x10",
+            vec![
+                step(Role::Check, "0x11", self.f1(up, start)),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "manual run", Action::Hold(25)),
+                step(Role::Check, "0x10", self.f1(release, start)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        self.motion(
+            "position/manual-then-target",
+            &["PSX-CMD-007", "PSX-CMD-004"],
+            "a target transferred during a manual run ends it and is approached at once",
+            vec![
+                step(Role::Check, "0x11", self.f1(up, start)),
+                step(Role::Check, "until running", Self::until(true)),
+                step(Role::Check, "manual run", Action::Hold(15)),
+                step(
+                    Role::Check,
+                    "0x14 to start+6000",
+                    self.f1(transfer, start + 6000),
+                ),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        let jog_key_release = self.control_bit("Release jog operation with keys");
+        let hold_ms = self
+            .value(isdu::JOG_WAIT)
+            .saturating_mul(5)
+            .saturating_add(200);
+        let hold = u64::try_from(hold_ms).unwrap_or(0);
+        self.motion(
+            "position/jog-step",
+            &["PSX-JOG-002", "PSX-JOG-005", "PSX-JOG-010"],
+            "with control bit 5 a short key press runs one jog step",
+            vec![
+                step(
+                    Role::Check,
+                    "control bit 5",
+                    self.f1(jog_key_release, start),
+                ),
+                step(
+                    Role::Check,
+                    "forward key",
+                    Action::Env(Env::Keys {
+                        forward: true,
+                        reverse: false,
+                    }),
+                ),
+                step(Role::Check, "cycles", Action::Hold(2)),
+                step(
+                    Role::Check,
+                    "released",
+                    Action::Env(Env::Keys {
+                        forward: false,
+                        reverse: false,
+                    }),
+                ),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        let continuous = self.control_bit("Release manual run in jog mode");
+        self.motion(
+            "position/jog-continuous",
+            &["PSX-JOG-006", "PSX-JOG-007", "PSX-JOG-009"],
+            "with control bits 5 and 3 a held key turns into a continuous run; both keys cancel it",
+            vec![
+                step(
+                    Role::Check,
+                    "control bits 5 and 3",
+                    self.f1(jog_key_release | continuous, start),
+                ),
+                step(
+                    Role::Check,
+                    "reverse key held",
+                    Action::Env(Env::Keys {
+                        forward: false,
+                        reverse: true,
+                    }),
+                ),
+                step(
+                    Role::Check,
+                    format!("held {hold} ms"),
+                    Action::Hold(self.cycles_for(hold)),
+                ),
+                step(
+                    Role::Check,
+                    "both keys",
+                    Action::Env(Env::Keys {
+                        forward: true,
+                        reverse: true,
+                    }),
+                ),
+                step(Role::Check, "until standstill", Self::until(false)),
+                step(
+                    Role::Check,
+                    "released",
+                    Action::Env(Env::Keys {
+                        forward: false,
+                        reverse: false,
+                    }),
+                ),
+                step(Role::Check, "cycles", Action::Hold(3)),
+            ],
+        );
+        let jog_bit = self.control_bit("Jog to larger values");
+        self.motion(
+            "position/jog-bit",
+            &["PSX-JOG-011", "PSX-JOG-005"],
+            "control bit 8 jogs like the forward key",
+            vec![
+                step(Role::Check, "control bit 8", self.f1(jog_bit, start)),
+                step(Role::Check, "cycles", Action::Hold(2)),
+                step(Role::Check, "0x00", self.f1(0, start)),
+                step(Role::Check, "until standstill", Self::until(false)),
+            ],
+        );
+        let key_hold = u64::from(self.cycles_for(hold)).saturating_mul(self.cycle_us);
+        let offline: Vec<StepDef> = [
+            Some(step(
+                Role::Check,
+                "connection lost",
+                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
+            )),
+            Some(step(
+                Role::Check,
+                "forward key held",
+                Action::Env(Env::Keys {
+                    forward: true,
+                    reverse: false,
+                }),
+            )),
+            Some(step(
+                Role::Check,
+                format!("held {hold} ms"),
+                Action::Silence(key_hold),
+            )),
+            Some(step(
+                Role::Check,
+                "released",
+                Action::Env(Env::Keys {
+                    forward: false,
+                    reverse: false,
+                }),
+            )),
+            Some(step(Role::Check, "silence 2 s", Action::Silence(2_000_000))),
+            Some(step(
+                Role::Check,
+                "connected",
+                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
+            )),
+            self.read(isdu::ACTUAL),
+            Some(step(Role::Check, "cycles", Action::Hold(3))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.motion(
+            "position/jog-offline",
+            &["PSX-JOG-001", "PSX-JOG-006"],
+            "without IO-Link connection a held key jogs continuously",
+            offline,
+        );
+        let upper = self.value(isdu::UPPER_LIMIT);
+        let steps: Vec<StepDef> = [
+            self.write(Role::Setup, isdu::LOOP_DIRECTION, 1),
+            Some(step(
+                Role::Check,
+                "0x14 to ISDU 129 with a backward loop",
+                self.f1(transfer, upper),
+            )),
+            Some(step(Role::Check, "refused", Action::Hold(SETTLE))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        self.motion(
+            "position/limit-against-loop",
+            &["PSX-RUN-008", "PSX-STS-12-SET-1"],
+            "the upper limit cannot be reached with a backward loop: refused with bit 12",
+            steps,
+        );
+    }
+}
+
+/// Every case for `model`, in run order; `base` is the reference drive at power-on and
+/// `cycle_us` the bus cycle.
+pub(crate) fn generate<'s>(
+    family: &Family,
+    model: &DeviceModel,
+    base: &Drive<'s>,
+    cycle_us: u64,
+) -> Result<(Vec<CaseInfo>, Vec<PsxCase>), String> {
+    let mut g = Gen {
+        family,
+        model,
+        rules: base.rules(),
+        base,
+        cycle_us,
+        errors: Vec::new(),
+        out: Vec::new(),
+    };
+    g.isdu_cases();
+    g.guard_cases();
+    g.command_cases();
+    g.format_cases();
+    g.timestamp_cases();
+    g.status_cases();
+    g.timeout_cases();
+    g.position_cases();
+    if let Some(e) = g.errors.first() {
+        return Err(format!("{e} ({} problem(s))", g.errors.len()));
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    for (info, _) in &g.out {
+        if !seen.insert(info.id.clone()) {
+            return Err(format!("duplicate case id {}", info.id));
+        }
+    }
+    Ok(g.out.into_iter().unzip())
+}

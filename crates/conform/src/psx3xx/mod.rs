@@ -1,0 +1,193 @@
+//! The PSx3xx conformance suite (manual chapters 3–5): cases generated from the spec's ISDU,
+//! protocol, bit and model tables and run over the cyclic-exchange protocol
+//! ([`crate::cyclic`]: process images each IO-Link cycle, `ISDU-READ`/`ISDU-WRITE` between
+//! cycles) against the reference drive model as oracle.
+//!
+//! Case groups (IDs `psx3xx/<group>/...`):
+//!
+//! | group | what |
+//! | --- | --- |
+//! | `isdu` | every index and sub-index of the table read; writes at both range edges, one beyond and in range gaps, read back; read-only writes; unknown indices and sub-indices; length overrun and underrun; the write lock of ISDU 12 |
+//! | `guard` | every guard entry: the directly following write dropped, writes without it and after the allow value executed, another write ending the suppression, not saved |
+//! | `command` | every ISDU 2 and ISDU 193 command with working and saved values across a power cycle; values that are no command; unsaved values lost, saved ones kept; entries never saved |
+//! | `format` | the three process-data formats: switch effective only after save and reset, device ID per format, a run in each format, the 8-byte speed rules (0 uses ISDU 142, given, changed, invalid, manual) |
+//! | `timestamp` | time-stamp runs: executed the stamp's delay after the field turns inactive, not while valid stamps keep coming, edge values, manual runs and cancel, without loop, ISDU control |
+//! | `status` | status bits after power-on, at the target, release withdrawn and cleared, motor voltage, temperature, displacement, target outside the limits, against the loop, jog keys, obstruction, position fault |
+//! | `timeout` | ISDU 118/137: time-out off, cancel, safe position, the reserved value |
+//! | `position` | runs with and without loop both ways, new target, transfer then release, manual runs, jog by key and by control bit |
+//!
+//! Every cycle's input image is compared with the reference's: status word exactly, position
+//! and speed within the case's declared tolerance; every ISDU and injection reply exactly,
+//! except the live speed and position read by ISDU, which get the same tolerance.
+
+mod gen;
+mod session;
+
+pub use session::Psx3xxSession;
+
+use crate::case::CaseInfo;
+use crate::cyclic::{LinkPeer, LocalPeer, Peer, Server};
+use crate::dut::Dut;
+use crate::link::{ExecLink, SerialLink, TcpLink};
+use crate::suite::{Session, Settings, SetupError, Suite};
+use drivespec_psx3xx::model::{Drive, DriveConfig};
+use drivespec_spec::{Family, FamilyId, Spec};
+use gen::PsxCase;
+
+/// The device model `--model` selects when none is given: the PSE 312-8 the spec's vectors
+/// assume (`spec/psx3xx/vectors/isdu.toml`).
+pub const DEFAULT_MODEL: &str = "PSE312-8";
+
+/// The model attribute holding the ISDU 79 model code (manual 3.1 ISDU 79).
+const MODEL_CODE: &str = "device_model_code";
+
+/// The ISDU 79 code the reference reports for the gearbox types whose code the manual does
+/// not document (PSX-ERRATUM-016, reading "list-incomplete"): a device reporting its own code
+/// differs in the cases that read ISDU 79 or the device ID, which then belong in its
+/// expectations file.
+pub const UNDOCUMENTED_CODE: u16 = 0;
+
+/// The PSx3xx suite for one device model.
+pub struct Psx3xxSuite<'s> {
+    family: &'s Family,
+    model: String,
+    baseline: Drive<'s>,
+    cycle_us: u64,
+    infos: Vec<CaseInfo>,
+    cases: Vec<PsxCase>,
+}
+
+impl<'s> Psx3xxSuite<'s> {
+    /// Generates the cases for `settings.model` (default [`DEFAULT_MODEL`]).
+    pub fn new(spec: &'s Spec, settings: &Settings) -> Result<Psx3xxSuite<'s>, SetupError> {
+        let family = spec.family(FamilyId::Psx3xx);
+        let query = settings.model.as_deref().unwrap_or(DEFAULT_MODEL);
+        let model = family.model(query).ok_or_else(|| {
+            let known: Vec<&str> = family.models.iter().map(|m| m.id.as_str()).collect();
+            SetupError::Usage(format!(
+                "unknown PSx3xx model {query:?}; known: {}",
+                known.join(", ")
+            ))
+        })?;
+        let mut config = DriveConfig::new(&model.id);
+        if model.attribute(MODEL_CODE).is_none() {
+            // PSX-ERRATUM-016: the ISDU 79 code of this gearbox type is undocumented.
+            config.model_code = Some(UNDOCUMENTED_CODE);
+        }
+        let baseline = Drive::new(spec, config).map_err(|e| SetupError::Spec(e.to_string()))?;
+        let cycle_us = min_cycle_us(&baseline)?;
+        let (infos, cases) =
+            gen::generate(family, model, &baseline, cycle_us).map_err(SetupError::Spec)?;
+        Ok(Psx3xxSuite {
+            family,
+            model: model.id.clone(),
+            baseline,
+            cycle_us,
+            infos,
+            cases,
+        })
+    }
+
+    /// The device model the cases are for.
+    pub fn model(&self) -> &str {
+        &self.model
+    }
+
+    /// The reference drive as every case expects the device at its start.
+    pub fn reference(&self) -> &Drive<'s> {
+        &self.baseline
+    }
+
+    /// The IO-Link cycle of the runner (µs): the device's MinCycleTime (PSX-DP-001).
+    pub fn cycle_us(&self) -> u64 {
+        self.cycle_us
+    }
+
+    /// A server on the reference drive (what `sim` runs, and what tests serve over tcp).
+    pub fn server(&self) -> Server<'s> {
+        Server::new(
+            &format!("drivespec reference {}", self.model),
+            FamilyId::Psx3xx.as_str(),
+            Box::new(self.baseline.clone()),
+        )
+    }
+
+    /// Opens a session on a peer of the caller's (tests, embedding tools).
+    pub fn session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psx3xxSession<'a, 's> {
+        Psx3xxSession::new(self, peer)
+    }
+
+    pub(crate) fn family(&self) -> &'s Family {
+        self.family
+    }
+
+    pub(crate) fn case(&self, index: usize) -> Option<(&CaseInfo, &PsxCase)> {
+        Some((self.infos.get(index)?, self.cases.get(index)?))
+    }
+
+    fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer + '_>, SetupError> {
+        // Real peers get 2 s per reply (a process may take a while to start).
+        const TIMEOUT_US: u64 = 2_000_000;
+        Ok(match dut {
+            Dut::Sim { .. } => Box::new(LocalPeer::new(
+                &format!("sim:{}", self.model),
+                self.server(),
+            )),
+            Dut::Serial { path, baud } => {
+                // The cyclic protocol is plain text: 8N1.
+                let character = drivespec_spec::hpd::CharacterFormat {
+                    source: "drivespec-cyclic/1".to_owned(),
+                    start_bits: 1,
+                    data_bits: 8,
+                    parity: drivespec_spec::hpd::Parity::None,
+                    stop_bits: 1,
+                    bits_per_char: 10,
+                };
+                Box::new(LinkPeer::new(
+                    Box::new(SerialLink::open(path, baud.unwrap_or(115_200), &character)?),
+                    TIMEOUT_US,
+                ))
+            }
+            Dut::Tcp { addr } => {
+                Box::new(LinkPeer::new(Box::new(TcpLink::connect(addr)?), TIMEOUT_US))
+            }
+            Dut::Exec { argv } => {
+                Box::new(LinkPeer::new(Box::new(ExecLink::spawn(argv)?), TIMEOUT_US))
+            }
+        })
+    }
+}
+
+/// The MinCycleTime of Direct Parameter page 1 in µs (PSX-DP-001).
+fn min_cycle_us(drive: &Drive<'_>) -> Result<u64, SetupError> {
+    let rules = drive.rules();
+    let code = match drive.value(&rules.protocol().device_id.model_param) {
+        drivespec_psx3xx::isdu::Value::Int(c) => u32::try_from(c).unwrap_or(0),
+        _ => 0,
+    };
+    let page = rules
+        .direct_page(drive.active_format(), code)
+        .and_then(|bytes| rules.decode_direct(0, &bytes))
+        .map_err(|e| SetupError::Spec(format!("Direct Parameter page: {e}")))?;
+    page.min_cycle_time_us
+        .map(u64::from)
+        .filter(|us| *us > 0)
+        .ok_or_else(|| SetupError::Spec("no MinCycleTime in the Direct Parameter page".to_owned()))
+}
+
+impl Suite for Psx3xxSuite<'_> {
+    fn family(&self) -> FamilyId {
+        FamilyId::Psx3xx
+    }
+
+    fn cases(&self) -> &[CaseInfo] {
+        &self.infos
+    }
+
+    fn open(&self, dut: &Dut) -> Result<Box<dyn Session + '_>, SetupError> {
+        let peer = self.peer(dut)?;
+        let mut s = self.session(peer);
+        s.hello().map_err(SetupError::Usage)?;
+        Ok(Box::new(s))
+    }
+}

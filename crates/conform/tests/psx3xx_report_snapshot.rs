@@ -1,0 +1,85 @@
+//! Snapshots of the JSON and JUnit reports of a small PSx3xx run against `sim` (`--case`
+//! globs): the guard entry of ISDU 111, an unknown index, and a time-stamp positioning with its
+//! plot data. Wall times are normalised; the coverage matrix keeps the rows these cases touch.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use drivespec_conform::report::junit;
+use drivespec_conform::{run, Options, Progress, Summary};
+use drivespec_spec::{FamilyId, Spec};
+
+fn small_run() -> Summary {
+    let spec = Spec::builtin().unwrap();
+    let opts = Options {
+        families: vec![FamilyId::Psx3xx],
+        case: vec![
+            "psx3xx/guard/111/s*".into(),
+            "psx3xx/isdu/unknown-index/65535".into(),
+            "psx3xx/timestamp/edge/first-*".into(),
+        ],
+        progress: Progress::Quiet,
+        no_reports: true,
+        ..Options::default()
+    };
+    let s = run(&spec, &opts, &mut std::io::sink()).unwrap();
+    assert_eq!(s.report.cases.len(), 3);
+    s
+}
+
+#[test]
+fn psx3xx_json_report_of_a_small_run() {
+    let s = small_run();
+    let mut v: serde_json::Value = serde_json::from_str(&s.report.json()).unwrap();
+    for c in v["cases"].as_array_mut().unwrap() {
+        c["wall_ms"] = 0.into();
+    }
+    v["tool"]["version"] = "VERSION".into();
+    let rows: Vec<serde_json::Value> = v["coverage"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| {
+            r["cases"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|c| c["status"] != "not-run")
+        })
+        .map(|r| {
+            let mut r = r.clone();
+            let run: Vec<serde_json::Value> = r["cases"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|c| c["status"] != "not-run")
+                .cloned()
+                .collect();
+            r["cases"] = run.into();
+            r
+        })
+        .collect();
+    v["coverage"] = rows.into();
+    insta::assert_json_snapshot!(v);
+}
+
+#[test]
+fn psx3xx_junit_report_of_a_small_run() {
+    let x = junit(&small_run().report);
+    let mut out = String::new();
+    for line in x.lines() {
+        // time="…" is wall-clock time.
+        let mut l = line.to_owned();
+        while let Some(i) = l.find("time=\"") {
+            let rest = &l[i + 6..];
+            let end = rest.find('"').unwrap();
+            l = format!("{}TIME={}", &l[..i], &rest[end + 1..]);
+        }
+        out.push_str(&l);
+        out.push('\n');
+    }
+    insta::assert_snapshot!(out);
+}

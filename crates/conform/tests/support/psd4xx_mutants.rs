@@ -1,0 +1,326 @@
+//! The PSD4xx mutants: the reference drive with one planted deviation (a wrapper around
+//! `psd4xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
+//! test (`psd4xx_mutants.rs`) and the fuzzer test (`fuzz_psd4xx.rs`).
+
+use super::mutants::spec;
+use drivespec_conform::cyclic::{CyclicDevice, Env};
+use drivespec_positioner::Micros;
+use drivespec_psd4xx::model::{Drive, RecordAnswer, RecordFailure, RecordRequest};
+use drivespec_psd4xx::{Input, Output, PkwRequest, Request};
+use drivespec_spec::FamilyId;
+
+fn bit(field: &str, name: &str) -> u16 {
+    let b = spec().family(FamilyId::Psd4xx).bitfield(field).unwrap();
+    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
+}
+
+/// The planted deviations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A repeated PKW command is executed again every cycle (answers before "no command").
+    PkwRefresh,
+    /// Error 1 (read-only) is reported as error 2.
+    ReadOnlyAsRange,
+    /// Status bit 10 is set together with bit 0.
+    Bits0And10,
+    /// The loop bit (control bit 6) is taken inverted: loop on the wrong runs.
+    LoopInverted,
+    /// A positive write answer does not echo PWE.
+    EchoMissing,
+    /// Control bit 13 is not copied into the status word.
+    ToggleNotEchoed,
+    /// Out-of-range writes are answered as accepted.
+    RangeIgnored,
+    /// A record write with control byte 0 is executed.
+    RecordControl0Executed,
+    /// Clearing the release during a run does not abort it.
+    ReleaseWithdrawalIgnored,
+    /// Command 0 is answered with the previous response instead of response 0.
+    NoResponseMissing,
+    /// Par 96 = -1 (delivery state) restores the user's values instead.
+    Par96DeliveryWrong,
+    /// The speed in the input image has the wrong sign.
+    SpeedSignInverted,
+    /// A new target during a run is ignored until standstill.
+    NewTargetIgnored,
+    /// Record reads of 16-bit values return 4 bytes.
+    RecordReadWide,
+    /// Status bit 10 (obstruction) is never set.
+    ObstructionBitMissing,
+}
+
+#[derive(Clone)]
+pub struct Mutant {
+    kind: Kind,
+    drive: Drive,
+    last_pkw: Option<PkwRequest>,
+    last_response: Option<drivespec_psd4xx::PkwResponse>,
+    running: bool,
+    target_in_force: i32,
+}
+
+impl Mutant {
+    /// The reference PSD 401 with the deviation `kind`.
+    pub fn new(kind: Kind) -> Mutant {
+        let drive = Drive::new(
+            spec(),
+            drivespec_psd4xx::model::DriveConfig::new("PSD401-5V"),
+        )
+        .unwrap();
+        Mutant {
+            kind,
+            drive,
+            last_pkw: None,
+            last_response: None,
+            running: false,
+            target_in_force: 0,
+        }
+    }
+}
+
+impl CyclicDevice<'static> for Mutant {
+    fn cycle(&mut self, now: Micros, image: &[u8]) -> Result<Vec<u8>, String> {
+        let rules = self.drive.rules().clone();
+        let pkw = rules.pkw();
+        let mut out = Output::parse(&rules, image).map_err(|e| e.to_string())?;
+        let original = out;
+        let release = bit("control", "Release");
+        let transfer = bit("control", "Transfer target value");
+        match self.kind {
+            Kind::PkwRefresh if self.last_pkw == Some(out.pkw) => {
+                let mut idle = out;
+                idle.pkw = PkwRequest::default();
+                let b = idle.to_bytes(&rules).unwrap();
+                self.drive.cycle(now, &b)?;
+            }
+            Kind::LoopInverted => out.control ^= bit("control", "Run without reference loop"),
+            Kind::ReleaseWithdrawalIgnored if self.running => out.control |= release,
+            Kind::NewTargetIgnored => {
+                if self.running && out.control & transfer != 0 {
+                    out.target = self.target_in_force;
+                } else if out.control & transfer != 0 {
+                    self.target_in_force = out.target;
+                }
+            }
+            Kind::Par96DeliveryWrong => {
+                let minus1 = pkw
+                    .encode_request(&Request::Write {
+                        pnu: 96,
+                        index: None,
+                        width: drivespec_psd4xx::Width::Word,
+                        value: -1,
+                    })
+                    .unwrap();
+                if out.pkw == minus1 {
+                    out.pkw = pkw
+                        .encode_request(&Request::Write {
+                            pnu: 96,
+                            index: None,
+                            width: drivespec_psd4xx::Width::Word,
+                            value: -2,
+                        })
+                        .unwrap();
+                }
+            }
+            _ => {}
+        }
+        let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
+        let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
+        let codes = pkw.error_codes();
+        let cannot = pkw.response_codes().cannot_execute;
+        match self.kind {
+            Kind::ReadOnlyAsRange
+                if input.pkw.ak == cannot && input.pkw.pwe == codes.read_only.0 =>
+            {
+                input.pkw.pwe = codes.out_of_range.0;
+            }
+            Kind::Bits0And10 if input.status & bit("status", "Target position reached") != 0 => {
+                input.status |= bit("status", "Positioning error (obstruction)");
+            }
+            Kind::EchoMissing => {
+                let write = pkw
+                    .command_info(original.pkw.ak)
+                    .is_some_and(|c| c.op == drivespec_spec::psd4xx::PkwOp::Write);
+                if write
+                    && input.pkw.ak != cannot
+                    && input.pkw.ak != pkw.response_codes().no_response
+                {
+                    input.pkw.pwe = 0;
+                }
+            }
+            Kind::ToggleNotEchoed => {
+                input.status &= !bit("status", "Toggle bit");
+            }
+            Kind::RangeIgnored
+                if input.pkw.ak == cannot && input.pkw.pwe == codes.out_of_range.0 =>
+            {
+                input.pkw.ak = pkw.expected_response(&original.pkw).unwrap_or(input.pkw.ak);
+                input.pkw.pwe = original.pkw.pwe;
+            }
+            Kind::NoResponseMissing if original.pkw == PkwRequest::default() => {
+                if let Some(r) = self.last_response {
+                    input.pkw = r;
+                }
+            }
+            Kind::Par96DeliveryWrong => {
+                input.pkw.pwe = if input.pkw.pnu == 96 && input.pkw.ak != cannot {
+                    original.pkw.pwe
+                } else {
+                    input.pkw.pwe
+                }
+            }
+            Kind::SpeedSignInverted => input.speed = input.speed.wrapping_neg(),
+            Kind::ObstructionBitMissing => {
+                input.status &= !bit("status", "Positioning error (obstruction)")
+            }
+            _ => {}
+        }
+        self.running = input.status & bit("status", "Drive is running") != 0;
+        self.last_pkw = Some(original.pkw);
+        if original.pkw != PkwRequest::default() {
+            self.last_response = Some(input.pkw);
+        }
+        Ok(input.to_bytes(&rules).unwrap())
+    }
+
+    fn advance(&mut self, now: Micros) {
+        CyclicDevice::advance(&mut self.drive, now);
+    }
+
+    fn record(
+        &mut self,
+        now: Micros,
+        req: RecordRequest,
+    ) -> Option<Result<RecordAnswer, RecordFailure>> {
+        let req = match (self.kind, req) {
+            (Kind::RecordControl0Executed, RecordRequest::Write { index, mut data }) => {
+                if data.first() == Some(&0) {
+                    data[0] = 1;
+                }
+                RecordRequest::Write { index, data }
+            }
+            (_, r) => r,
+        };
+        let r = self.drive.record(now, req);
+        match (self.kind, r) {
+            (Kind::RecordReadWide, Some(Ok(RecordAnswer::Data { bytes }))) if bytes.len() == 2 => {
+                let mut wide = vec![0, 0];
+                wide.extend(bytes);
+                Some(Ok(RecordAnswer::Data { bytes: wide }))
+            }
+            (_, r) => r,
+        }
+    }
+
+    fn env(&mut self, now: Micros, env: Env) -> bool {
+        self.drive.env(now, env)
+    }
+
+    fn clone_box(&self) -> Box<dyn CyclicDevice<'static>> {
+        Box::new(self.clone())
+    }
+}
+
+/// A mutant, its name, and the conformance cases that must fail against it.
+pub struct Case {
+    pub kind: Kind,
+    pub name: &'static str,
+    pub must_fail: &'static [&'static str],
+}
+
+/// Every PSD4xx mutant.
+pub fn mutants() -> Vec<Case> {
+    use Kind::*;
+    vec![
+        Case {
+            kind: PkwRefresh,
+            name: "pkw-answers-before-no-command",
+            must_fail: &[
+                "psd4xx/pkw/held-while-running",
+                "psd4xx/pkw/reread-after-no-command",
+            ],
+        },
+        Case {
+            kind: ReadOnlyAsRange,
+            name: "wrong-error-code",
+            must_fail: &[
+                "psd4xx/pkw/write/1/read-only",
+                "psd4xx/pkw/write/14/read-only",
+            ],
+        },
+        Case {
+            kind: Bits0And10,
+            name: "status-bits-0-and-10-together",
+            must_fail: &[
+                "psd4xx/position/loop/up",
+                "psd4xx/sequence/seq-position-0x14",
+            ],
+        },
+        Case {
+            kind: LoopInverted,
+            name: "loop-on-the-wrong-side",
+            must_fail: &["psd4xx/position/loop/down", "psd4xx/position/no-loop/down"],
+        },
+        Case {
+            kind: EchoMissing,
+            name: "write-echo-missing",
+            must_fail: &["psd4xx/pkw/write/44/max", "psd4xx/pkw/write/3/min"],
+        },
+        Case {
+            kind: ToggleNotEchoed,
+            name: "toggle-bit-not-echoed",
+            must_fail: &["psd4xx/status/toggle"],
+        },
+        Case {
+            kind: RangeIgnored,
+            name: "range-ignored",
+            must_fail: &[
+                "psd4xx/pkw/write/44/above-max",
+                "psd4xx/pkw/write/45/below-min",
+            ],
+        },
+        Case {
+            kind: RecordControl0Executed,
+            name: "record-control-byte-0-executed",
+            must_fail: &["psd4xx/record/write/44/control-0"],
+        },
+        Case {
+            kind: ReleaseWithdrawalIgnored,
+            name: "release-withdrawal-not-aborting",
+            must_fail: &[
+                "psd4xx/position/release-withdrawn",
+                "psd4xx/sequence/seq-abort-release-withdrawn",
+            ],
+        },
+        Case {
+            kind: NoResponseMissing,
+            name: "no-response-missing",
+            must_fail: &["psd4xx/pkw/read/44"],
+        },
+        Case {
+            kind: Par96DeliveryWrong,
+            name: "par96-delivery-restores-user-values",
+            must_fail: &["psd4xx/par96/minus-1"],
+        },
+        Case {
+            kind: SpeedSignInverted,
+            name: "speed-sign-inverted",
+            must_fail: &["psd4xx/position/manual/up"],
+        },
+        Case {
+            kind: NewTargetIgnored,
+            name: "new-target-during-run-ignored",
+            must_fail: &["psd4xx/position/new-target/same-direction"],
+        },
+        Case {
+            kind: RecordReadWide,
+            name: "record-read-16-bit-as-4-bytes",
+            must_fail: &["psd4xx/record/read/44"],
+        },
+        Case {
+            kind: ObstructionBitMissing,
+            name: "obstruction-bit-missing",
+            must_fail: &["psd4xx/status/obstruction"],
+        },
+    ]
+}
