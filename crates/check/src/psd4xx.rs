@@ -184,9 +184,15 @@ pub struct PsdDrive<'s> {
     spm_state: bool,
     records: BTreeMap<u16, Vec<u8>>,
     timeline: Timeline,
-    /// Capture time of the first event: the oracle's clock counts from here.
-    epoch: Option<u64>,
+    /// The oracle's clock: (capture time of the latest event, oracle time then).
+    clock: Option<(u64, u64)>,
 }
+
+/// The longest pause between two events the oracle lives through (µs): a longer one (a
+/// capture paused, or a crafted time stamp) counts as this long. The oracle judges parameter
+/// writes, which do not depend on how long the drive stood, and it simulates every
+/// millisecond it is moved on, so the work per event stays bounded.
+const MAX_GAP_US: u64 = 1_000_000;
 
 fn command_requirement(rules: &PkwRules, ak: CommandCode) -> &'static str {
     let Some(info) = rules.command_info(ak) else {
@@ -247,7 +253,7 @@ impl<'s> PsdDrive<'s> {
             spm_state: false,
             records: BTreeMap::new(),
             timeline: Timeline::new(label, names),
-            epoch: None,
+            clock: None,
         }
     }
 
@@ -276,11 +282,14 @@ impl<'s> PsdDrive<'s> {
     }
 
     /// The oracle's time for a capture time: µs since the drive's first event (the model
-    /// simulates every µs it is advanced, so it must not start at 1970).
+    /// simulates every tick it is advanced, so it must not start at 1970), with pauses longer
+    /// than [`MAX_GAP_US`] shortened to it.
     fn model_time(&mut self, at: Where) -> Option<u64> {
         let t = at.time?;
-        let e = *self.epoch.get_or_insert(t);
-        Some(t.saturating_sub(e))
+        let (last, now) = self.clock.unwrap_or((t, 0));
+        let now = now.saturating_add(t.saturating_sub(last).min(MAX_GAP_US));
+        self.clock = Some((t.max(last), now));
+        Some(now)
     }
 
     fn pkw(&self) -> &PkwRules {

@@ -139,13 +139,9 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
             json(&serde_json::json!({
                 "summary": s,
                 "reports": summary.written,
-                "unavailable": r.run.unavailable,
             }))
         ),
         Format::Text => {
-            for u in &r.run.unavailable {
-                println!("{}: {}", u.family, u.reason);
-            }
             for c in r.cases.iter().filter(|c| c.status == Status::Fixed) {
                 println!(
                     "fixed: {} passes; remove it from the expectations file",

@@ -12,7 +12,6 @@ use crate::case::{CaseInfo, CaseRun, Outcome};
 use crate::dut::{shell_quote, Dut};
 use crate::report::{
     self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, Report, RunInfo, Status, Tool,
-    Unavailable,
 };
 use crate::select::{Expectations, LevelFilter, SelectError, Selection};
 use crate::suite::{self, Session, Settings, SetupError, Suite};
@@ -124,9 +123,6 @@ pub enum ConformError {
     /// A suite or the transport could not be set up.
     #[error(transparent)]
     Setup(#[from] SetupError),
-    /// No family asked for has a suite.
-    #[error("no conformance suite for {0}")]
-    Nothing(String),
     /// A report could not be written.
     #[error("cannot write {file}: {why}")]
     Write {
@@ -176,20 +172,8 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         opts.families.clone()
     };
     let mut suites: Vec<Box<dyn Suite + '_>> = Vec::new();
-    let mut unavailable = Vec::new();
     for f in wanted {
-        match suite::suite(spec, f, &settings) {
-            Ok(s) => suites.push(s),
-            Err(SetupError::NoSuite(f)) => unavailable.push(Unavailable {
-                family: f,
-                reason: format!("no conformance suite for {f} yet: its reference model and cyclic-exchange adapter protocol are not written"),
-            }),
-            Err(e) => return Err(e.into()),
-        }
-    }
-    if suites.is_empty() {
-        let names: Vec<String> = unavailable.iter().map(|u| u.family.to_string()).collect();
-        return Err(ConformError::Nothing(names.join(", ")));
+        suites.push(suite::suite(spec, f, &settings)?);
     }
     let mut plan: Vec<(usize, usize)> = Vec::new();
     for (si, s) in suites.iter().enumerate() {
@@ -210,7 +194,6 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             &suites,
             Vec::new(),
             "",
-            unavailable,
             &expectations,
             spec,
         );
@@ -292,7 +275,6 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         &suites,
         results,
         &transport,
-        unavailable,
         &expectations,
         spec,
     );
@@ -411,7 +393,6 @@ fn build_report(
     suites: &[Box<dyn Suite + '_>],
     cases: Vec<CaseReport>,
     transport: &str,
-    unavailable: Vec<Unavailable>,
     expectations: &Expectations,
     spec: &Spec,
 ) -> Report {
@@ -503,7 +484,6 @@ fn build_report(
             skip: opts.skip.clone(),
             level: opts.level.as_str().to_owned(),
             expectations: expectations.file.clone(),
-            unavailable,
         },
         summary: counts,
         cases,

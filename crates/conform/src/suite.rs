@@ -40,9 +40,6 @@ pub enum SetupError {
     /// The spec lacks what the suite needs.
     #[error("spec: {0}")]
     Spec(String),
-    /// The family has no suite yet.
-    #[error("no conformance suite for {0} yet")]
-    NoSuite(FamilyId),
 }
 
 /// The cases of one family.

@@ -188,7 +188,6 @@ fn serial_over_a_pty_passes_frames_params_vectors_commands_and_every_baud_code()
     // The runner followed every Pr26 change: the drive never saw bytes at a wrong rate.
     assert_eq!(stats.refused, 0, "{stats:?}");
     assert!(stats.sent > 300, "{stats:?}");
-    assert!(started.elapsed() < Duration::from_secs(60));
 }
 
 #[cfg(unix)]

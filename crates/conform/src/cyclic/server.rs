@@ -181,12 +181,19 @@ impl<'s> CyclicDevice<'s> for PsxDrive<'s> {
     }
 }
 
+/// The most virtual time one request may move the clock on (µs, one hour): the model
+/// simulates every tick it is advanced, so a peer sending an absurd time must not hold the
+/// server for days.
+pub const MAX_STEP_US: u64 = 3_600_000_000;
+
 /// Serves one device over `drivespec-cyclic/1`.
 pub struct Server<'s> {
     name: String,
     family: String,
     start: Box<dyn CyclicDevice<'s> + 's>,
     device: Box<dyn CyclicDevice<'s> + 's>,
+    /// The latest time a request carried since the last `RESET`.
+    clock: u64,
 }
 
 impl<'s> Server<'s> {
@@ -198,6 +205,7 @@ impl<'s> Server<'s> {
             family: family.to_owned(),
             start: device.clone_box(),
             device,
+            clock: 0,
         }
     }
 
@@ -206,8 +214,18 @@ impl<'s> Server<'s> {
         self.family == FamilyId::Psx3xx.as_str()
     }
 
-    /// Answers one request.
+    /// Answers one request; a time more than [`MAX_STEP_US`] after the latest one is refused
+    /// with `ERR`.
     pub fn handle(&mut self, req: Request) -> Reply {
+        if let Some(t) = req.time() {
+            if t.saturating_sub(self.clock) > MAX_STEP_US {
+                return Reply::Err(format!(
+                    "time {t} is more than {MAX_STEP_US} µs after the latest ({})",
+                    self.clock
+                ));
+            }
+            self.clock = self.clock.max(t);
+        }
         match req {
             Request::Hello {
                 version, family, ..
@@ -225,6 +243,7 @@ impl<'s> Server<'s> {
             }
             Request::Reset => {
                 self.device = self.start.clone_box();
+                self.clock = 0;
                 Reply::Ok
             }
             Request::Cycle { t, image } => match self.device.cycle(t, &image) {
@@ -352,5 +371,33 @@ mod tests {
         assert_eq!(s.handle_line("ENV 0 keys both"), "UNSUPPORTED");
         assert_eq!(s.handle_line("ENV 0 control-voltage 240"), "OK");
         assert!(s.handle_line("READ 0 44").starts_with("DATA"));
+    }
+
+    #[test]
+    fn a_time_jump_beyond_the_bound_is_refused_not_simulated() {
+        let spec = Spec::builtin().unwrap_or_else(|e| panic!("{e:?}"));
+        let suite = crate::psd4xx::Psd4xxSuite::new(&spec, &Settings::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut s = suite.server();
+        assert_eq!(s.handle_line("RESET"), "OK");
+        assert!(s
+            .handle_line("ADVANCE 18446744073709551615")
+            .starts_with("ERR"));
+        let step = super::MAX_STEP_US;
+        assert_eq!(
+            s.handle_line(&format!("ADVANCE {}", step + 1)),
+            format!(
+                "ERR time {} is more than {step} µs after the latest (0)",
+                step + 1
+            )
+        );
+        assert_eq!(s.handle_line("ADVANCE 1000"), "OK");
+        assert!(s
+            .handle_line(&format!("READ {} 44", step + 1000))
+            .starts_with("DATA"));
+        assert_eq!(s.handle_line("RESET"), "OK");
+        assert!(s
+            .handle_line(&format!("ADVANCE {}", step + 1))
+            .starts_with("ERR"));
     }
 }

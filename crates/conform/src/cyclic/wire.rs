@@ -301,6 +301,20 @@ fn end(line: &str, mut words: std::str::SplitWhitespace<'_>) -> Result<(), WireE
 }
 
 impl Request {
+    /// The virtual time the request carries; None for `HELLO` and `RESET`.
+    pub fn time(&self) -> Option<u64> {
+        match self {
+            Request::Hello { .. } | Request::Reset => None,
+            Request::Cycle { t, .. }
+            | Request::Advance { t }
+            | Request::Read { t, .. }
+            | Request::Write { t, .. }
+            | Request::IsduRead { t, .. }
+            | Request::IsduWrite { t, .. }
+            | Request::Env { t, .. } => Some(*t),
+        }
+    }
+
     /// Parses one request line (without its `\n`).
     pub fn parse(line: &str) -> Result<Request, WireError> {
         let mut w = line.split_whitespace();

@@ -196,7 +196,6 @@ pub(crate) fn build(
             skip: Vec::new(),
             level: "should".to_owned(),
             expectations: None,
-            unavailable: Vec::new(),
         },
         summary: Counts {
             total: cases.len(),

@@ -57,14 +57,6 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
         "<table><tr><th>cases</th><th class=\"pass\">pass</th><th class=\"fail\">fail</th><th class=\"expected-failure\">expected failures</th><th class=\"fixed\">fixed</th><th class=\"skipped\">skipped</th><th class=\"not-run\">not run</th></tr><tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr></table>",
         s.total, s.passed, s.failed, s.expected_failures, s.fixed, s.skipped, s.not_run
     );
-    for u in &r.run.unavailable {
-        let _ = writeln!(
-            h,
-            "<p class=\"muted\">{}: {}</p>",
-            u.family,
-            escape(&u.reason)
-        );
-    }
     for k in &r.stale_expectations {
         let _ = writeln!(
             h,

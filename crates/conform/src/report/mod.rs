@@ -101,17 +101,6 @@ pub struct RunInfo {
     pub level: String,
     /// The expectations file, when given.
     pub expectations: Option<String>,
-    /// Families asked for that have no suite yet, with the reason.
-    pub unavailable: Vec<Unavailable>,
-}
-
-/// A family without a suite.
-#[derive(Debug, Clone, Serialize)]
-pub struct Unavailable {
-    /// The family.
-    pub family: FamilyId,
-    /// Why.
-    pub reason: String,
 }
 
 /// Counts of a run.
