@@ -1,6 +1,7 @@
 //! PSD4xx mutation tests: the reference drive with one planted deviation
 //! (`support::psd4xx_mutants`, served over the cyclic protocol in-process) as the device under
-//! test. Each mutant must fail the cases named for it; the mutation score is printed.
+//! test. Each mutant must fail the cases named for it, and every case it fails must cite a
+//! requirement the deviation breaks; the mutation score is printed.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -28,9 +29,21 @@ fn every_psd4xx_mutant_fails_the_cases_covering_its_deviation() {
     for m in &all {
         let server = Server::new(m.name, "psd4xx", Box::new(Mutant::new(m.kind)));
         let mut session = suite.session(Box::new(LocalPeer::new(m.name, server)));
+        let breaks: Vec<Pattern> = m.breaks.iter().map(|b| Pattern::new(b).unwrap()).collect();
         let mut failed = Vec::new();
         for (i, info) in suite.cases().iter().enumerate() {
-            if let Outcome::Fail(_) = session.run(i).outcome {
+            if let Outcome::Fail(f) = session.run(i).outcome {
+                let cites = f
+                    .requirements
+                    .iter()
+                    .any(|r| breaks.iter().any(|b| b.matches(&r.id)));
+                if !cites {
+                    let ids: Vec<&str> = f.requirements.iter().map(|r| r.id.as_str()).collect();
+                    problems.push(format!(
+                        "{}: {} failed without citing {:?} (cites {ids:?}): {}",
+                        m.name, info.id, m.breaks, f.message
+                    ));
+                }
                 failed.push(info.id.clone());
             }
         }

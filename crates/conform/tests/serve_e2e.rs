@@ -148,7 +148,6 @@ fn conform_passes(dut: &Dut, cases: &[&str]) -> Summary {
 #[cfg(unix)]
 #[test]
 fn serial_over_a_pty_passes_frames_params_vectors_commands_and_every_baud_code() {
-    let started = Instant::now();
     let (served, path) = serve_pty(Faults::default());
     let dut = Dut::Serial { path, baud: None };
     let s = conform_passes(

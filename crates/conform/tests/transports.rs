@@ -103,7 +103,6 @@ fn tcp_against_the_reference_drive_passes() {
         },
         TCP_CASES,
     );
-    let started = Instant::now();
     let summary = run(&spec, &opts, &mut std::io::sink()).unwrap();
     let r = &summary.report;
     let failed: Vec<String> = r

@@ -114,6 +114,47 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
             .collect()
     }
 
+    /// The case's requirements plus those of what differs in a cycle: the PKW handshake
+    /// rules (3.6: response held, value of the moment, command 0 answered with 0, one command
+    /// at a time) when the PKW block differs, the speed (par. 2) and position (par. 3) rules
+    /// when those differ, and the set/reset rules of every status bit that differs (spec
+    /// bitfield `status`).
+    fn cited(&self, case: &[String], dut: Option<&Input>, reference: &Input) -> Vec<String> {
+        let mut ids = case.to_vec();
+        let mut add = |id: &str| {
+            if !ids.iter().any(|x| x == id) {
+                ids.push(id.to_owned());
+            }
+        };
+        let Some(d) = dut else {
+            return ids;
+        };
+        if d.pkw != reference.pkw {
+            for id in ["PSD-PKW-003", "PSD-PKW-004", "PSD-PKW-006", "PSD-PKW-007"] {
+                add(id);
+            }
+        }
+        if d.speed != reference.speed {
+            add("PSD-PAR-2-001");
+        }
+        if d.actual != reference.actual {
+            add("PSD-PAR-3-001");
+        }
+        let differs = d.status ^ reference.status;
+        if let Some(field) = self.suite.family().bitfield("status") {
+            for b in field
+                .bits
+                .iter()
+                .filter(|b| b.bit < 16 && differs & (1 << b.bit) != 0)
+            {
+                for rule in &b.rules {
+                    add(&rule.requirement);
+                }
+            }
+        }
+        ids
+    }
+
     fn describe(&self, i: &Input) -> String {
         let pkw = self
             .suite
@@ -418,7 +459,7 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
                     ),
                     expected: self.describe(&c.reference),
                     got,
-                    requirements: self.refs(run.reqs),
+                    requirements: self.refs(&self.cited(run.reqs, c.dut.as_ref().ok(), &c.reference)),
                 });
             }
         }

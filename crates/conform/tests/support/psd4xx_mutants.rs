@@ -221,11 +221,13 @@ impl CyclicDevice<'static> for Mutant {
     }
 }
 
-/// A mutant, its name, and the conformance cases that must fail against it.
+/// A mutant, its name, the conformance cases that must fail against it, and the requirement
+/// IDs (glob patterns) its deviation breaks.
 pub struct Case {
     pub kind: Kind,
     pub name: &'static str,
     pub must_fail: &'static [&'static str],
+    pub breaks: &'static [&'static str],
 }
 
 /// Every PSD4xx mutant.
@@ -239,6 +241,13 @@ pub fn mutants() -> Vec<Case> {
                 "psd4xx/pkw/held-while-running",
                 "psd4xx/pkw/reread-after-no-command",
             ],
+            breaks: &[
+                "PSD-PKW-005",
+                "PSD-PKW-003",
+                "PSD-PKW-004",
+                "PSD-PKW-006",
+                "PSD-PKW-007",
+            ],
         },
         Case {
             kind: ReadOnlyAsRange,
@@ -247,6 +256,7 @@ pub fn mutants() -> Vec<Case> {
                 "psd4xx/pkw/write/1/read-only",
                 "psd4xx/pkw/write/14/read-only",
             ],
+            breaks: &["PSD-PKW-024"],
         },
         Case {
             kind: Bits0And10,
@@ -255,21 +265,38 @@ pub fn mutants() -> Vec<Case> {
                 "psd4xx/position/loop/up",
                 "psd4xx/sequence/seq-position-0x14",
             ],
+            breaks: &["PSD-STS-0-*", "PSD-STS-10-*"],
         },
         Case {
             kind: LoopInverted,
             name: "loop-on-the-wrong-side",
             must_fail: &["psd4xx/position/loop/down", "psd4xx/position/no-loop/down"],
+            breaks: &[
+                "PSD-POS-*",
+                "PSD-STS-*",
+                "PSD-RUN-*",
+                "PSD-PAR-3-001",
+                "PSD-PAR-32-*",
+                "PSD-PKW-004",
+            ],
         },
         Case {
             kind: EchoMissing,
             name: "write-echo-missing",
             must_fail: &["psd4xx/pkw/write/44/max", "psd4xx/pkw/write/3/min"],
+            breaks: &[
+                "PSD-PKW-034",
+                "PSD-PKW-003",
+                "PSD-PKW-004",
+                "PSD-PKW-006",
+                "PSD-PKW-007",
+            ],
         },
         Case {
             kind: ToggleNotEchoed,
             name: "toggle-bit-not-echoed",
             must_fail: &["psd4xx/status/toggle"],
+            breaks: &["PSD-CTL-13-001", "PSD-STS-2-*"],
         },
         Case {
             kind: RangeIgnored,
@@ -278,11 +305,20 @@ pub fn mutants() -> Vec<Case> {
                 "psd4xx/pkw/write/44/above-max",
                 "psd4xx/pkw/write/45/below-min",
             ],
+            breaks: &[
+                "PSD-PAR-RANGE-001",
+                "PSD-PKW-025",
+                "PSD-PKW-003",
+                "PSD-PKW-004",
+                "PSD-PKW-006",
+                "PSD-PKW-007",
+            ],
         },
         Case {
             kind: RecordControl0Executed,
             name: "record-control-byte-0-executed",
             must_fail: &["psd4xx/record/write/44/control-0"],
+            breaks: &["PSD-REC-*"],
         },
         Case {
             kind: ReleaseWithdrawalIgnored,
@@ -291,36 +327,43 @@ pub fn mutants() -> Vec<Case> {
                 "psd4xx/position/release-withdrawn",
                 "psd4xx/sequence/seq-abort-release-withdrawn",
             ],
+            breaks: &["PSD-ABORT-*", "PSD-STS-5-*", "PSD-RUN-001"],
         },
         Case {
             kind: NoResponseMissing,
             name: "no-response-missing",
             must_fail: &["psd4xx/pkw/read/44"],
+            breaks: &["PSD-PKW-006", "PSD-PKW-003"],
         },
         Case {
             kind: Par96DeliveryWrong,
             name: "par96-delivery-restores-user-values",
             must_fail: &["psd4xx/par96/minus-1"],
+            breaks: &["PSD-PAR-96-*"],
         },
         Case {
             kind: SpeedSignInverted,
             name: "speed-sign-inverted",
             must_fail: &["psd4xx/position/manual/up"],
+            breaks: &["PSD-PAR-2-001", "PSD-PKW-004"],
         },
         Case {
             kind: NewTargetIgnored,
             name: "new-target-during-run-ignored",
             must_fail: &["psd4xx/position/new-target/same-direction"],
+            breaks: &["PSD-POS-002", "PSD-POS-003"],
         },
         Case {
             kind: RecordReadWide,
             name: "record-read-16-bit-as-4-bytes",
             must_fail: &["psd4xx/record/read/44"],
+            breaks: &["PSD-REC-*"],
         },
         Case {
             kind: ObstructionBitMissing,
             name: "obstruction-bit-missing",
             must_fail: &["psd4xx/status/obstruction"],
+            breaks: &["PSD-STS-10-*", "PSD-OBST-*"],
         },
     ]
 }
