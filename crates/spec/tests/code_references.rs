@@ -25,8 +25,15 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// IDs such as `HPD-FRAME-004` or `PSD-ERRATUM-059` in a text.
-fn ids(text: &str) -> Vec<String> {
+/// An ID named in code: exact (`HPD-FRAME-004`) or a glob over IDs (`PSD-STS-0-*`).
+#[derive(Debug, PartialEq)]
+enum Named {
+    Id(String),
+    Prefix(String),
+}
+
+/// IDs such as `HPD-FRAME-004` or `PSD-ERRATUM-059`, and globs such as `PSD-STS-0-*`, in a text.
+fn ids(text: &str) -> Vec<Named> {
     let mut found = Vec::new();
     let bytes = text.as_bytes();
     for prefix in ["HPD-", "PSD-", "PSX-"] {
@@ -40,8 +47,13 @@ fn ids(text: &str) -> Vec<String> {
                 .map_or(text.len(), |e| start + e);
             let id = text[start..end].trim_end_matches('-');
             // `-FIXTURE-` IDs are deliberately absent: tests use them to build broken specs.
+            let glob = text[end..].starts_with('*');
             if boundary && id.split('-').count() >= 3 && !id.contains("-FIXTURE-") {
-                found.push(id.to_owned());
+                found.push(if glob {
+                    Named::Prefix(format!("{id}-"))
+                } else {
+                    Named::Id(id.to_owned())
+                });
             }
             from = end.max(start + 1);
         }
@@ -62,17 +74,30 @@ fn ids_named_in_code_exist() {
     let mut missing = Vec::new();
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap();
-        for id in ids(&text) {
+        for named in ids(&text) {
+            let (Named::Id(id) | Named::Prefix(id)) = &named;
             let family = match &id[..3] {
                 "HPD" => FamilyId::Hpd,
                 "PSD" => FamilyId::Psd4xx,
                 _ => FamilyId::Psx3xx,
             };
             let fam = spec.family(family);
-            let known = fam.requirement(&id).is_some() || fam.errata.iter().any(|e| e.id == id);
+            let mut all = fam
+                .requirements
+                .iter()
+                .map(|r| r.id.as_str())
+                .chain(fam.errata.iter().map(|e| e.id.as_str()));
+            let known = match &named {
+                Named::Id(id) => all.any(|known| known == id),
+                Named::Prefix(prefix) => all.any(|known| known.starts_with(prefix.as_str())),
+            };
             if !known {
+                let shown = match &named {
+                    Named::Id(id) => id.clone(),
+                    Named::Prefix(prefix) => format!("{prefix}* (matches nothing)"),
+                };
                 missing.push(format!(
-                    "{}: {id}",
+                    "{}: {shown}",
                     f.strip_prefix(&root).unwrap_or(f).display()
                 ));
             }
@@ -91,7 +116,14 @@ fn ids_named_in_code_exist() {
 fn id_scanner_finds_ids_and_nothing_else() {
     assert_eq!(
         ids("see HPD-FRAME-004, and PSD-STS-10-RESET."),
-        ["HPD-FRAME-004", "PSD-STS-10-RESET"]
+        [
+            Named::Id("HPD-FRAME-004".into()),
+            Named::Id("PSD-STS-10-RESET".into())
+        ]
     );
-    assert_eq!(ids("XHPD-FRAME-004 HPD-X"), Vec::<String>::new());
+    assert_eq!(
+        ids(r#"breaks: &["PSD-STS-0-*", "PSD-POS-*"]"#),
+        [Named::Prefix("PSD-STS-0-".into())]
+    );
+    assert_eq!(ids("XHPD-FRAME-004 HPD-X"), Vec::<Named>::new());
 }
