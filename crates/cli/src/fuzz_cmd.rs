@@ -14,7 +14,7 @@ use std::time::Duration;
 /// Fuzz a device under test with sequences generated from the spec (exit 1 on findings).
 #[derive(clap::Args)]
 pub struct FuzzArgs {
-    /// Family: hpd or psd4xx (psx3xx is not available yet).
+    /// Family: hpd, psd4xx or psx3xx.
     family: String,
     /// Device under test: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS'.
     #[arg(long, default_value = "sim")]
@@ -80,9 +80,6 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
     let Some(family) = FamilyId::parse(&args.family) else {
         bail!("unknown family {:?}: hpd, psd4xx or psx3xx", args.family)
     };
-    if !matches!(family, FamilyId::Hpd | FamilyId::Psd4xx) {
-        return Err(fuzz::FuzzError::NotAvailable(family).into());
-    }
     let dut: Dut = args.dut.parse()?;
     let opts = Options {
         family,

@@ -29,10 +29,10 @@ fn temp(name: &str) -> PathBuf {
 }
 
 #[test]
-fn other_families_are_not_available_yet() {
-    let (code, _, err) = drivespec(&["fuzz", "psx3xx"]);
+fn bad_usage_is_refused() {
+    let (code, _, err) = drivespec(&["fuzz", "psx4xx"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("not available yet"), "{err}");
+    assert!(err.contains("hpd, psd4xx or psx3xx"), "{err}");
     let (code, _, _) = drivespec(&["fuzz", "hpd", "--iterations", "3", "--duration", "1s"]);
     assert_eq!(code, 2);
     let (code, _, err) = drivespec(&["fuzz", "hpd", "--duration", "10 parsecs"]);

@@ -15,9 +15,9 @@
 //! device that dies or hangs is a finding, and the run goes on after restarting it. Nothing
 //! here panics on any device behaviour or replay file.
 //!
-//! HPD (`hpd` target, serial frames) and PSD4xx (`psd4xx` target, the cyclic-exchange
-//! protocol); PSx3xx joins by implementing the crate-internal `Target` (`engine.rs`) with its
-//! generator and session.
+//! HPD (`hpd` target, serial frames), PSD4xx (`psd4xx` target) and PSx3xx (`psx3xx` target),
+//! both over the cyclic-exchange protocol; each implements the crate-internal `Target`
+//! (`engine.rs`) with its generator and the family's conformance session.
 
 mod ddmin;
 mod engine;
@@ -26,6 +26,8 @@ mod hpd_gen;
 mod output;
 mod psd4xx;
 mod psd4xx_gen;
+mod psx3xx;
+mod psx3xx_gen;
 mod replay;
 mod stats;
 
@@ -42,6 +44,7 @@ use crate::dut::{shell_quote, Dut};
 use crate::hpd::HpdSuite;
 use crate::link::Link;
 use crate::psd4xx::Psd4xxSuite;
+use crate::psx3xx::Psx3xxSuite;
 use crate::report::{self, Report};
 use crate::runner::Progress;
 use crate::suite::{Settings, SetupError};
@@ -57,7 +60,7 @@ pub const DEFAULT_ITERATIONS: u64 = 1000;
 /// Everything `drivespec fuzz` takes.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// The family (HPD or PSD4xx).
+    /// The family (HPD, PSD4xx or PSx3xx).
     pub family: FamilyId,
     /// The device under test.
     pub dut: Dut,
@@ -103,9 +106,6 @@ impl Default for Options {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum FuzzError {
-    /// The family has no fuzzer yet.
-    #[error("fuzzing {0} is not available yet: it has no fuzz target (hpd and psd4xx have)")]
-    NotAvailable(FamilyId),
     /// The suite, the reference or the transport could not be set up.
     #[error(transparent)]
     Setup(#[from] SetupError),
@@ -189,9 +189,10 @@ fn effective(opts: &Options) -> Settings {
 
 /// A device under test of the caller's, instead of the transport `Options::dut` names.
 pub enum Device {
-    /// A byte link: HPD frames, or `drivespec-cyclic/1` lines for PSD4xx.
+    /// A byte link: HPD frames, or `drivespec-cyclic/1` lines for PSD4xx and PSx3xx.
     Link(Box<dyn Link>),
-    /// A cyclic-exchange peer (PSD4xx): e.g. a [`crate::cyclic::LocalPeer`] on a test device.
+    /// A cyclic-exchange peer (PSD4xx, PSx3xx): e.g. a [`crate::cyclic::LocalPeer`] on a test
+    /// device.
     Peer(Box<dyn Peer>),
 }
 
@@ -232,7 +233,16 @@ fn with_target<R>(
             let mut target = psd4xx::Psd4xxTarget::new(&suite, peer)?;
             f(&mut target)
         }
-        other => Err(FuzzError::NotAvailable(other)),
+        FamilyId::Psx3xx => {
+            let suite = Psx3xxSuite::new(spec, settings)?;
+            let peer: Box<dyn Peer + '_> = match device {
+                Some(Device::Peer(p)) => p,
+                Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
+                None => suite.peer(&opts.dut)?,
+            };
+            let mut target = psx3xx::Psx3xxTarget::new(&suite, peer)?;
+            f(&mut target)
+        }
     }
 }
 
@@ -255,8 +265,8 @@ pub fn run_on(
     run_on_device(spec, opts, Device::Link(link), progress)
 }
 
-/// [`run`] on a device of the caller's: a link, or a cyclic-exchange peer (PSD4xx mutants,
-/// embedding tools); `opts.dut` only names it in the reports.
+/// [`run`] on a device of the caller's: a link, or a cyclic-exchange peer (PSD4xx and PSx3xx
+/// mutants, embedding tools); `opts.dut` only names it in the reports.
 pub fn run_on_device(
     spec: &Spec,
     opts: &Options,

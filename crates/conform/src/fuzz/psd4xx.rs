@@ -168,7 +168,11 @@ fn kind(s: Option<&Step>) -> String {
             CyclicStep::RecordRead { .. } => "record-read",
             CyclicStep::RecordWrite { .. } => "record-write",
             CyclicStep::Advance { .. } => "advance",
-            CyclicStep::Pkw { .. } | CyclicStep::Env(_) => "cyclic",
+            CyclicStep::Pkw { .. }
+            | CyclicStep::Env(_)
+            | CyclicStep::ProcessData { .. }
+            | CyclicStep::IsduRead { .. }
+            | CyclicStep::IsduWrite { .. } => "cyclic",
         }
         .to_owned(),
         Some(_) => "not-cyclic".to_owned(),
@@ -216,6 +220,9 @@ fn to_case_step(s: &Step) -> StepDef {
             }),
             CyclicStep::Env(env) => gen::Action::Env(*env),
             CyclicStep::Advance { us } => gen::Action::Advance((*us).min(MAX_ADVANCE_US)),
+            CyclicStep::ProcessData { .. }
+            | CyclicStep::IsduRead { .. }
+            | CyclicStep::IsduWrite { .. } => gen::Action::Hold(1),
         },
         _ => gen::Action::Hold(1),
     };

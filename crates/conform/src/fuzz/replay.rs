@@ -65,12 +65,14 @@ pub enum Action {
     },
     /// Follows the bit rate the reference uses now (serial ports, after b42.3).
     BitRate,
-    /// A step of the cyclic-exchange protocol (PSD4xx, README "Cyclic-exchange protocol").
+    /// A step of the cyclic-exchange protocol (PSD4xx, PSx3xx; README "Cyclic-exchange
+    /// protocol").
     Cyclic(CyclicStep),
 }
 
 /// What one step of a cyclic-exchange sequence does; device and reference get the same
-/// requests, every cycle's input image and every reply is judged (PSD4xx manual 3.5–3.9).
+/// requests, every cycle's input image and every reply is judged (PSD4xx manual 3.5–3.9;
+/// PSx3xx manual 3.1, 3.3).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CyclicStep {
     /// New control word and/or target (absent: unchanged), then one cycle (3.5.1).
@@ -132,6 +134,37 @@ pub enum CyclicStep {
         /// How long (µs).
         us: Micros,
     },
+    /// A PSx3xx process output in `format`, then one cycle (PSx3xx manual 3.3.1): format 0
+    /// sends `control` as the time-stamp code with `stamp`, format 1 the control word and
+    /// `target`, format 2 also `speed`.
+    ProcessData {
+        /// Output format (0, 1, 2).
+        format: u8,
+        /// Control word (formats 1, 2) or time-stamp code (format 0).
+        control: u16,
+        /// Target position (formats 1, 2).
+        target: i32,
+        /// Target speed (format 2).
+        speed: i16,
+        /// Time stamp (format 0).
+        stamp: u16,
+    },
+    /// A PSx3xx ISDU read between two cycles (PSx3xx manual 3.1).
+    IsduRead {
+        /// ISDU index.
+        index: u16,
+        /// Sub-index.
+        subindex: u8,
+    },
+    /// A PSx3xx ISDU write between two cycles, most significant octet first (3.1).
+    IsduWrite {
+        /// ISDU index.
+        index: u16,
+        /// Sub-index.
+        subindex: u8,
+        /// The octets.
+        data: Vec<u8>,
+    },
 }
 
 impl CyclicStep {
@@ -146,6 +179,27 @@ impl CyclicStep {
             CyclicStep::RecordWrite { .. } => "record-write",
             CyclicStep::Env(_) => "env",
             CyclicStep::Advance { .. } => "advance",
+            CyclicStep::ProcessData { .. } => "pd-out",
+            CyclicStep::IsduRead { .. } => "isdu-read",
+            CyclicStep::IsduWrite { .. } => "isdu-write",
+        }
+    }
+
+    /// The family a step belongs to; None for steps every cyclic family has.
+    pub fn family(&self) -> Option<FamilyId> {
+        match self {
+            CyclicStep::Process { .. }
+            | CyclicStep::Offset { .. }
+            | CyclicStep::Pkw { .. }
+            | CyclicStep::RecordRead { .. }
+            | CyclicStep::RecordWrite { .. } => Some(FamilyId::Psd4xx),
+            CyclicStep::ProcessData { .. }
+            | CyclicStep::IsduRead { .. }
+            | CyclicStep::IsduWrite { .. } => Some(FamilyId::Psx3xx),
+            CyclicStep::Hold { .. }
+            | CyclicStep::Until { .. }
+            | CyclicStep::Env(_)
+            | CyclicStep::Advance { .. } => None,
         }
     }
 }
@@ -169,12 +223,14 @@ impl Action {
     pub fn bytes(&self) -> Option<&[u8]> {
         match self {
             Action::Exchange { bytes, .. } | Action::Send { bytes } => Some(bytes),
-            Action::Cyclic(CyclicStep::RecordWrite { data, .. }) => Some(data),
+            Action::Cyclic(
+                CyclicStep::RecordWrite { data, .. } | CyclicStep::IsduWrite { data, .. },
+            ) => Some(data),
             _ => None,
         }
     }
 
-    /// The same action with other bytes (exchanges and sends only).
+    /// The same action with other bytes (exchanges, sends, record and ISDU writes).
     pub fn with_bytes(&self, new: Vec<u8>) -> Action {
         match self {
             Action::Exchange {
@@ -193,6 +249,13 @@ impl Action {
                     data: new,
                 })
             }
+            Action::Cyclic(CyclicStep::IsduWrite {
+                index, subindex, ..
+            }) => Action::Cyclic(CyclicStep::IsduWrite {
+                index: *index,
+                subindex: *subindex,
+                data: new,
+            }),
             other => other.clone(),
         }
     }
@@ -448,6 +511,14 @@ struct StepFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     index: Option<u16>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    subindex: Option<u8>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    format: Option<u8>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    speed: Option<i16>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    stamp: Option<u16>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     env: Option<String>,
     #[serde(default)]
     class: String,
@@ -479,6 +550,10 @@ impl StepFile {
             running: None,
             max: None,
             index: None,
+            subindex: None,
+            format: None,
+            speed: None,
+            stamp: None,
             env: None,
             class: s.class.clone(),
             text: s.text.clone(),
@@ -529,6 +604,31 @@ impl StepFile {
                 }
                 CyclicStep::Env(env) => f.env = Some(env.to_string()),
                 CyclicStep::Advance { us } => f.us = Some(*us),
+                CyclicStep::ProcessData {
+                    format,
+                    control,
+                    target,
+                    speed,
+                    stamp,
+                } => {
+                    f.format = Some(*format);
+                    f.control = Some(*control);
+                    match format {
+                        0 => f.stamp = Some(*stamp),
+                        1 => f.target = Some(*target),
+                        _ => {
+                            f.target = Some(*target);
+                            f.speed = Some(*speed);
+                        }
+                    }
+                }
+                CyclicStep::IsduRead { index, subindex }
+                | CyclicStep::IsduWrite {
+                    index, subindex, ..
+                } => {
+                    f.index = Some(*index);
+                    f.subindex = Some(*subindex);
+                }
             },
             _ => {}
         }
@@ -607,9 +707,25 @@ impl StepFile {
             "advance" => Action::Cyclic(CyclicStep::Advance {
                 us: need(self.us, index, &action_name, "us")?,
             }),
+            "pd-out" => Action::Cyclic(CyclicStep::ProcessData {
+                format: need(self.format, index, &action_name, "format")?,
+                control: need(self.control, index, &action_name, "control")?,
+                target: self.target.unwrap_or(0),
+                speed: self.speed.unwrap_or(0),
+                stamp: self.stamp.unwrap_or(0),
+            }),
+            "isdu-read" => Action::Cyclic(CyclicStep::IsduRead {
+                index: need(self.index, index, &action_name, "index")?,
+                subindex: self.subindex.unwrap_or(0),
+            }),
+            "isdu-write" => Action::Cyclic(CyclicStep::IsduWrite {
+                index: need(self.index, index, &action_name, "index")?,
+                subindex: self.subindex.unwrap_or(0),
+                data: bytes()?,
+            }),
             other => {
                 return Err(format!(
-                    "step {index}: unknown action {other:?} (exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate; cyclic: process, offset, pkw, hold, until, record-read, record-write, env, advance)"
+                    "step {index}: unknown action {other:?} (exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate; cyclic: hold, until, env, advance; psd4xx: process, offset, pkw, record-read, record-write; psx3xx: pd-out, isdu-read, isdu-write)"
                 ))
             }
         };
@@ -667,11 +783,12 @@ impl Replay {
             .collect::<Result<Vec<Step>, String>>()
             .map_err(bad)?;
         let cyclic = f.family != FamilyId::Hpd;
-        if let Some((i, s)) = steps
-            .iter()
-            .enumerate()
-            .find(|(_, s)| matches!(s.action, Action::Cyclic(_)) != cyclic)
-        {
+        // Cyclic steps of another family (PSD4xx records in a PSx3xx file) are refused too.
+        let foreign = |a: &Action| match a {
+            Action::Cyclic(c) => !cyclic || c.family().is_some_and(|x| x != f.family),
+            _ => cyclic,
+        };
+        if let Some((i, s)) = steps.iter().enumerate().find(|(_, s)| foreign(&s.action)) {
             return Err(bad(format!(
                 "step {i}: `{}` is not a {} step",
                 s.action.name(),
@@ -852,6 +969,74 @@ mod tests {
             .steps
             .push(step(CyclicStep::Hold { cycles: 1 }));
         assert!(Replay::from_json(&hpd_with_cyclic.to_json(), "x").is_err());
+    }
+
+    #[test]
+    fn psx3xx_steps_round_trip_and_stay_in_their_family() {
+        let step = |c: CyclicStep| Step {
+            action: Action::Cyclic(c),
+            class: "x".into(),
+            text: String::new(),
+            requirements: vec![],
+        };
+        let r = Replay {
+            family: FamilyId::Psx3xx,
+            steps: vec![
+                step(CyclicStep::ProcessData {
+                    format: 0,
+                    control: 3,
+                    target: 0,
+                    speed: 0,
+                    stamp: 16_383,
+                }),
+                step(CyclicStep::ProcessData {
+                    format: 1,
+                    control: 0x14,
+                    target: -4000,
+                    speed: 0,
+                    stamp: 0,
+                }),
+                step(CyclicStep::ProcessData {
+                    format: 2,
+                    control: 0x11,
+                    target: 12,
+                    speed: -1,
+                    stamp: 0,
+                }),
+                step(CyclicStep::IsduRead {
+                    index: 0,
+                    subindex: 16,
+                }),
+                step(CyclicStep::IsduWrite {
+                    index: 116,
+                    subindex: 0,
+                    data: vec![2],
+                }),
+                step(CyclicStep::Env(Env::Keys {
+                    forward: true,
+                    reverse: false,
+                })),
+                step(CyclicStep::Hold { cycles: 2 }),
+            ],
+            ..sample()
+        };
+        let text = r.to_json();
+        assert_eq!(Replay::from_json(&text, "x").unwrap(), r);
+        assert!(text.contains("\"do\": \"isdu-write\""), "{text}");
+        // The bytes of an ISDU write are what minimisation shortens.
+        assert_eq!(r.steps[4].action.bytes(), Some(&[2u8][..]));
+        // PSx3xx steps in a PSD4xx or HPD file, and PSD4xx steps in a PSx3xx file, are refused.
+        let psd = text.replace("\"psx3xx\"", "\"psd4xx\"");
+        assert!(Replay::from_json(&psd, "x").is_err());
+        let hpd = text.replace("\"psx3xx\"", "\"hpd\"");
+        assert!(Replay::from_json(&hpd, "x").is_err());
+        let mut with_record = r.clone();
+        with_record
+            .steps
+            .push(step(CyclicStep::RecordRead { index: 44 }));
+        assert!(Replay::from_json(&with_record.to_json(), "x").is_err());
+        let bad = text.replace("\"format\": 2,", "");
+        assert!(Replay::from_json(&bad, "x").is_err());
     }
 
     #[test]

@@ -88,14 +88,14 @@ pub(crate) struct Tolerance {
 }
 
 /// Tolerance of the motion cases: ±3 cycles, ±20 steps, ±2 rpm.
-const MOTION: Tolerance = Tolerance {
+pub(crate) const MOTION: Tolerance = Tolerance {
     cycles: 3,
     position: 20,
     speed: 2,
 };
 
 /// Tolerance of the ISDU cases: every cycle and every live value exact.
-const EXACT: Tolerance = Tolerance {
+pub(crate) const EXACT: Tolerance = Tolerance {
     cycles: 0,
     position: 0,
     speed: 0,

@@ -20,7 +20,7 @@
 //! and speed within the case's declared tolerance; every ISDU and injection reply exactly,
 //! except the live speed and position read by ISDU, which get the same tolerance.
 
-mod gen;
+pub(crate) mod gen;
 mod session;
 
 pub use session::Psx3xxSession;
@@ -125,7 +125,7 @@ impl<'s> Psx3xxSuite<'s> {
         Some((self.infos.get(index)?, self.cases.get(index)?))
     }
 
-    fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer + '_>, SetupError> {
+    pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer + '_>, SetupError> {
         // Real peers get 2 s per reply (a process may take a while to start).
         const TIMEOUT_US: u64 = 2_000_000;
         Ok(match dut {

@@ -5,7 +5,7 @@ use super::gen::{Action, PsxCase, Tolerance};
 use super::Psx3xxSuite;
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::cyclic::wire::hex;
-use crate::cyclic::{Peer, Reply, Request, Server, VERSION};
+use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server, VERSION};
 use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psx3xx::isdu::{ErrorType, Request as IsduRequest};
@@ -20,6 +20,8 @@ pub struct Psx3xxSession<'a, 's> {
     /// ISDU indices of the live speed and position (3.3.2 `rpm`, `actual`), judged within
     /// the case's speed and position tolerance.
     live: Vec<(u16, Live)>,
+    /// The first transport failure of the case run last.
+    peer_error: Option<PeerError>,
 }
 
 /// Which tolerance a live ISDU value gets.
@@ -46,6 +48,8 @@ struct Run<'r, 's> {
     out: Output,
     t: u64,
     cycles: Vec<Cycle>,
+    /// The step being run.
+    step: usize,
     evidence: Vec<Record>,
     failure: Option<Failure>,
     reqs: &'r [String],
@@ -90,6 +94,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
             peer,
             running_bit,
             live,
+            peer_error: None,
         }
     }
 
@@ -108,6 +113,36 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
             )),
             Err(e) => Err(format!("{}: {e}", self.peer.describe())),
         }
+    }
+
+    /// The first transport failure of the case run last, if any (taken).
+    pub(crate) fn take_peer_error(&mut self) -> Option<PeerError> {
+        self.peer_error.take()
+    }
+
+    /// Whether the device takes the injection `env` (`ENV` answered `OK`; the injections are
+    /// optional, README "Cyclic-exchange protocol"). The device is reset after it; a transport
+    /// failure counts as no (and the device is restarted).
+    pub(crate) fn takes(&mut self, env: Env) -> bool {
+        let ok = match self.peer.call(&Request::Env { t: 0, env }) {
+            Ok(r) => r == Reply::Ok,
+            Err(_) => {
+                self.restart();
+                return false;
+            }
+        };
+        if self.peer.call(&Request::Reset).is_err() {
+            self.restart();
+        }
+        ok
+    }
+
+    /// Notes a transport failure, then reconnects or restarts the peer and greets it again.
+    fn failed(&mut self, e: &PeerError) {
+        if self.peer_error.is_none() {
+            self.peer_error = Some(e.clone());
+        }
+        self.restart();
     }
 
     /// After a transport error: reconnect or restart the peer and greet it again.
@@ -160,7 +195,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
         let dut = match self.peer.call(&req) {
             Ok(r) => self.parse_input(&r),
             Err(e) => {
-                self.restart();
+                self.failed(&e);
                 run.cycles.push(Cycle {
                     step,
                     t: run.t,
@@ -274,7 +309,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
                 (Some(r), t)
             }
             Err(e) => {
-                self.restart();
+                self.failed(&e);
                 (None, format!("error: {e}"))
             }
         };
@@ -322,6 +357,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
 
     fn run_steps(&mut self, case: &PsxCase, run: &mut Run<'_, 's>) -> Result<(), String> {
         for (n, s) in case.steps.iter().enumerate() {
+            run.step = n;
             let first = run.cycles.len();
             match &s.action {
                 Action::Out(out) => {
@@ -498,13 +534,15 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
         }
     }
 
-    fn run_case(&mut self, info: &CaseInfo, case: &PsxCase) -> CaseRun {
+    pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &PsxCase) -> CaseRun {
+        self.peer_error = None;
         let mut run = Run {
             reference: self.suite.server(),
             tol: case.tol,
             out: case.start,
             t: 0,
             cycles: Vec::new(),
+            step: 0,
             evidence: Vec::new(),
             failure: None,
             reqs: &info.requirements,
@@ -513,7 +551,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
             Ok(Reply::Ok) => Ok(()),
             Ok(other) => Err(format!("RESET answered with {other}")),
             Err(e) => {
-                self.restart();
+                self.failed(&e);
                 Err(e.to_string())
             }
         };
@@ -534,7 +572,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
         if let Err(e) = self.run_steps(case, &mut run) {
             if run.failure.is_none() {
                 run.failure = Some(Failure {
-                    step: run.cycles.last().map(|c| c.step),
+                    step: Some(run.step),
                     message: format!("the exchange failed: {e}"),
                     expected: "a reply".to_owned(),
                     got: e,

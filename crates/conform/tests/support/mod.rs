@@ -1,6 +1,6 @@
-//! Shared test support: the HPD mutants (`mutants`), the PSD4xx mutants (`psd4xx_mutants`)
-//! and the reference drive on a TCP port (`reference_server`, behind `faulty_relay.py`). Each
-//! test file uses only part of it.
+//! Shared test support: the HPD mutants (`mutants`), the PSD4xx mutants (`psd4xx_mutants`),
+//! the PSx3xx mutants (`psx3xx_mutants`) and the reference drive on a TCP port
+//! (`reference_server`, behind `faulty_relay.py`). Each test file uses only part of it.
 #![allow(
     dead_code,
     missing_docs,
@@ -12,4 +12,5 @@
 
 pub mod mutants;
 pub mod psd4xx_mutants;
+pub mod psx3xx_mutants;
 pub mod reference_server;

@@ -1,0 +1,343 @@
+//! The PSx3xx fuzz target: sequences from [`super::psx3xx_gen`], run as a case through the
+//! conformance session ([`Psx3xxSession`]) over the cyclic-exchange protocol, so every cycle's
+//! input image and every ISDU and injection reply is judged exactly as `drivespec conform`
+//! judges it: the reference drive fed the same requests, ISDU replies and the status word
+//! exact (ErrorTypes the spec accepts as variants included), position and speed within the
+//! motion cases' tolerance when the sequence may move the drive (manual 3.1–3.4, 4, 5).
+//!
+//! Environment injections are optional in the protocol: before the first sequence each kind
+//! the generator uses is tried once (then `RESET`), and only the kinds the device takes
+//! (`OK`) are sent.
+//!
+//! A failing step is a crash when the transport failed (the process exited, the connection
+//! closed), a hang when the device sent no reply within the protocol's time-out (2 s), and a
+//! mismatch otherwise; the signature names the step kind and what differs.
+
+use super::engine::{self, Fault, Target, Trial};
+use super::psx3xx_gen::{PsxGen, ENV_KINDS};
+use super::replay::{Action, CyclicStep, FindingClass, Start, Step};
+use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use crate::cyclic::{Peer, PeerError};
+use crate::link::{Caps, LinkError};
+use crate::psx3xx::gen::{self, PsxCase, StepDef, EXACT, MOTION};
+use crate::psx3xx::{Psx3xxSession, Psx3xxSuite};
+use crate::rng::Rng;
+use crate::suite::SetupError;
+use drivespec_psx3xx::isdu::Request as IsduRequest;
+use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
+use drivespec_spec::hex::parse_hex;
+use drivespec_spec::{FamilyId, Level};
+
+/// The PSx3xx target on one device under test.
+pub(crate) struct Psx3xxTarget<'a, 's> {
+    suite: &'a Psx3xxSuite<'s>,
+    session: Psx3xxSession<'a, 's>,
+    gen: PsxGen<'s>,
+    /// ISDU indices whose writes may move the drive: the commands (ISDU 2, 193) and the
+    /// control word and target of the time-stamp format (ISDU 110, 112).
+    moving: Vec<u16>,
+}
+
+impl<'a, 's> Psx3xxTarget<'a, 's> {
+    /// A target on `peer` (greeted with `HELLO`), with the reference from `suite`.
+    pub(crate) fn new(
+        suite: &'a Psx3xxSuite<'s>,
+        peer: Box<dyn Peer + 'a>,
+    ) -> Result<Psx3xxTarget<'a, 's>, SetupError> {
+        let mut session = suite.session(peer);
+        session.hello().map_err(SetupError::Usage)?;
+        // Only the injections the device takes are sent (they are optional).
+        let envs: Vec<String> = ENV_KINDS
+            .iter()
+            .filter(|e| session.takes(**e))
+            .map(|e| {
+                e.to_string()
+                    .split(' ')
+                    .next()
+                    .unwrap_or_default()
+                    .to_owned()
+            })
+            .collect();
+        let gen = PsxGen::new(suite, envs).map_err(SetupError::Spec)?;
+        let rules = suite.reference().rules();
+        let ts = rules.timestamp();
+        let family = suite.family();
+        let moving = ["2", "193", &ts.control_word_param, &ts.target_param]
+            .iter()
+            .filter_map(|id| family.parameters.iter().find(|p| p.id == *id))
+            .filter_map(|p| u16::try_from(p.number).ok())
+            .collect();
+        Ok(Psx3xxTarget {
+            suite,
+            session,
+            gen,
+            moving,
+        })
+    }
+
+    fn case(&self, steps: &[Step]) -> (CaseInfo, PsxCase) {
+        let mut requirements: Vec<String> = steps
+            .iter()
+            .flat_map(|s| s.requirements.iter().cloned())
+            .collect();
+        requirements.sort();
+        requirements.dedup();
+        let info = CaseInfo {
+            id: "psx3xx/fuzz/sequence".to_owned(),
+            family: FamilyId::Psx3xx,
+            requirements,
+            level: Level::Must,
+            description: "a fuzz sequence".to_owned(),
+            steps: steps.iter().map(|s| s.text.clone()).collect(),
+        };
+        // The motion cases' tolerance as soon as anything may move the drive; the ISDU
+        // cases' (exact) otherwise.
+        let moves = steps.iter().any(|s| match &s.action {
+            Action::Cyclic(
+                CyclicStep::IsduRead { .. } | CyclicStep::Hold { .. } | CyclicStep::Advance { .. },
+            ) => false,
+            Action::Cyclic(CyclicStep::IsduWrite { index, .. }) => self.moving.contains(index),
+            _ => true,
+        });
+        let d = self.suite.reference().rules().default_format();
+        let case = PsxCase {
+            start: idle(self.suite, d),
+            steps: steps.iter().map(to_case_step).collect(),
+            tol: if moves { MOTION } else { EXACT },
+            plot: false,
+        };
+        (info, case)
+    }
+
+    /// Which parts of the failing step's answer differ: `reply` for ISDU replies and
+    /// injections, the input-image fields otherwise (`status-b<bits>`, `speed`, `position`).
+    fn differs(&self, run: &CaseRun, step: usize) -> String {
+        let Some(r) = run
+            .evidence
+            .iter()
+            .find(|r| r.step == step && r.ok == Some(false))
+        else {
+            return "input-image".to_owned();
+        };
+        if r.sent.is_none() {
+            return "reply".to_owned();
+        }
+        let d = self.suite.reference();
+        let image = |a: Option<&crate::case::Answer>| {
+            a.and_then(|a| parse_hex(&a.hex).ok())
+                .and_then(|b| Input::parse(d.rules(), d.byte_order(), &b).ok())
+        };
+        let (Some(e), Some(g)) = (image(r.expected.as_ref()), image(r.got.as_ref())) else {
+            return "no-image".to_owned();
+        };
+        let mut parts: Vec<String> = Vec::new();
+        let bits = e.status ^ g.status;
+        if bits != 0 {
+            let list: Vec<String> = (0..16u16)
+                .filter(|b| bits & (1 << b) != 0)
+                .map(|b| b.to_string())
+                .collect();
+            parts.push(format!("status-b{}", list.join("+")));
+        }
+        if e.rpm != g.rpm {
+            parts.push("speed".to_owned());
+        }
+        if e.actual != g.actual {
+            parts.push("position".to_owned());
+        }
+        if parts.is_empty() {
+            // The last cycle of the step agrees; an earlier one did not.
+            "input-image".to_owned()
+        } else {
+            parts.join(",")
+        }
+    }
+}
+
+/// Most cycles one `hold` or `until` step runs: a replay file cannot make a run endless.
+const MAX_STEP_CYCLES: u32 = 60_000;
+
+/// Longest `advance` step (10 min).
+const MAX_ADVANCE_US: u64 = 600_000_000;
+
+/// The all-zero output of a format (format 0: the stamp inactive).
+fn idle(suite: &Psx3xxSuite<'_>, format: u8) -> Output {
+    let inactive = Stamp::inactive(suite.reference().rules().timestamp());
+    output(format, 0, 0, 0, inactive.0)
+}
+
+/// The process output of a `pd-out` step (manual 3.3.1).
+fn output(format: u8, control: u16, target: i32, speed: i16, stamp: u16) -> Output {
+    match format {
+        0 => Output::TimeStamp {
+            control: TsCode(u8::try_from(control).unwrap_or(u8::MAX)),
+            stamp: Stamp(stamp),
+        },
+        1 => Output::ControlTarget {
+            control_word: control,
+            target,
+        },
+        _ => Output::SpeedControlTarget {
+            target_speed: speed,
+            control_word: control,
+            target,
+        },
+    }
+}
+
+/// What kind of step a fuzz step is, for signatures.
+fn kind(s: Option<&Step>) -> String {
+    match s.map(|s| &s.action) {
+        Some(Action::Cyclic(CyclicStep::ProcessData { format, .. })) => {
+            format!("pd-format-{format}")
+        }
+        Some(Action::Cyclic(CyclicStep::IsduRead { index, .. })) => format!("isdu-read-{index}"),
+        Some(Action::Cyclic(CyclicStep::IsduWrite { index, .. })) => {
+            format!("isdu-write-{index}")
+        }
+        Some(Action::Cyclic(CyclicStep::Env(env))) => {
+            let text = env.to_string();
+            format!("env-{}", text.split(' ').next().unwrap_or("?"))
+        }
+        Some(Action::Cyclic(c)) => match c {
+            CyclicStep::Hold { .. } => "hold",
+            CyclicStep::Until { .. } => "until",
+            CyclicStep::Advance { .. } => "advance",
+            _ => "cyclic",
+        }
+        .to_owned(),
+        Some(_) => "not-cyclic".to_owned(),
+        None => "start".to_owned(),
+    }
+}
+
+/// A fuzz step as a conformance step (judged). Steps of other protocols never reach here
+/// (replay files are checked on load); they would cycle once with the outputs unchanged.
+fn to_case_step(s: &Step) -> StepDef {
+    let action = match &s.action {
+        Action::Cyclic(c) => match c {
+            CyclicStep::ProcessData {
+                format,
+                control,
+                target,
+                speed,
+                stamp,
+            } => gen::Action::Out(output(*format, *control, *target, *speed, *stamp)),
+            CyclicStep::IsduRead { index, subindex } => gen::Action::Isdu(IsduRequest::Read {
+                index: *index,
+                subindex: *subindex,
+            }),
+            CyclicStep::IsduWrite {
+                index,
+                subindex,
+                data,
+            } => gen::Action::Isdu(IsduRequest::Write {
+                index: *index,
+                subindex: *subindex,
+                data: data.clone(),
+            }),
+            CyclicStep::Hold { cycles } => gen::Action::Hold((*cycles).min(MAX_STEP_CYCLES)),
+            CyclicStep::Until { running, max } => gen::Action::Until {
+                running: *running,
+                max: (*max).min(MAX_STEP_CYCLES),
+            },
+            CyclicStep::Env(env) => gen::Action::Env(*env),
+            CyclicStep::Advance { us } => gen::Action::Silence((*us).min(MAX_ADVANCE_US)),
+            CyclicStep::Process { .. }
+            | CyclicStep::Offset { .. }
+            | CyclicStep::Pkw { .. }
+            | CyclicStep::RecordRead { .. }
+            | CyclicStep::RecordWrite { .. } => gen::Action::Hold(1),
+        },
+        _ => gen::Action::Hold(1),
+    };
+    StepDef {
+        role: Role::Check,
+        text: s.text.clone(),
+        action,
+    }
+}
+
+impl Target for Psx3xxTarget<'_, '_> {
+    fn family(&self) -> FamilyId {
+        FamilyId::Psx3xx
+    }
+
+    fn describe(&self) -> String {
+        crate::suite::Session::describe(&self.session)
+    }
+
+    fn caps(&self) -> Caps {
+        // Every run starts with `RESET` on the device and a fresh reference, on any transport;
+        // times are virtual (carried in the requests).
+        Caps {
+            reset: true,
+            power_cycle: true,
+            virtual_time: true,
+            inputs: false,
+        }
+    }
+
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
+        self.gen.sequence(rng)
+    }
+
+    fn fresh(&mut self) -> Result<Start, LinkError> {
+        // The case run resets both sides itself (and restarts a device that died).
+        Ok(Start::Fresh)
+    }
+
+    fn warm_up(&mut self) {}
+
+    fn run(&mut self, steps: &[Step]) -> Trial {
+        let (info, case) = self.case(steps);
+        let mut run = self.session.run_case(&info, &case);
+        let peer_error = self.session.take_peer_error();
+        let Outcome::Fail(mut failure) = run.outcome.clone() else {
+            return Trial { run, fault: None };
+        };
+        let step = failure.step.unwrap_or(0);
+        let (class, detail) = match &peer_error {
+            Some(PeerError::Timeout { .. }) => (FindingClass::Hang, String::new()),
+            Some(PeerError::Link(_)) => (FindingClass::Crash, String::new()),
+            Some(PeerError::Garbage { .. }) => (FindingClass::Mismatch, "/garbage".to_owned()),
+            None if failure.message.starts_with("the exchange failed") => {
+                (FindingClass::Mismatch, "/exchange".to_owned())
+            }
+            None => (
+                FindingClass::Mismatch,
+                format!("/{}", self.differs(&run, step)),
+            ),
+        };
+        // The failing step's requirements, not the whole sequence's.
+        if let Some(s) = steps.get(step) {
+            failure.requirements = s
+                .requirements
+                .iter()
+                .filter_map(|id| self.requirement(id))
+                .collect();
+        }
+        if let Some(e) = &peer_error {
+            failure.message = format!("{} ({e})", failure.message);
+        }
+        run.outcome = Outcome::Fail(failure.clone());
+        let signature = format!("{}/{}{detail}", class.as_str(), kind(steps.get(step)));
+        Trial {
+            run,
+            fault: Some(Fault {
+                class,
+                step,
+                signature,
+                failure,
+            }),
+        }
+    }
+
+    fn requirement(&self, id: &str) -> Option<RequirementRef> {
+        engine::requirement_ref(self.suite.family(), id)
+    }
+
+    fn requirement_ids(&self) -> Vec<(String, Level)> {
+        engine::requirement_ids(self.suite.family())
+    }
+}

@@ -1,0 +1,434 @@
+//! The PSx3xx mutants: the reference drive with one planted deviation (a wrapper around
+//! `psx3xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
+//! test (`psx3xx_mutants.rs`) and the fuzzer test (`fuzz_psx3xx.rs`).
+
+use super::mutants::spec;
+use drivespec_conform::cyclic::{CyclicDevice, Env, Reply};
+use drivespec_conform::psx3xx::Psx3xxSuite;
+use drivespec_conform::suite::Settings;
+use drivespec_positioner::Micros;
+use drivespec_psx3xx::isdu::{Request, Target, Value};
+use drivespec_psx3xx::model::Drive;
+use drivespec_psx3xx::{Guards, Output, Stamp};
+use drivespec_spec::{Access, Readings};
+
+/// The planted deviations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A guard's suppress value is acknowledged but ignored.
+    GuardIgnored,
+    /// A delayed time stamp is executed while valid stamps keep coming.
+    StampWhileActive,
+    /// Format 2 speed 0 runs at half of ISDU 142 instead of ISDU 142.
+    SpeedZeroNoFallback,
+    /// IDX_NOTAVAIL answered as SUBIDX_NOTAVAIL.
+    WrongErrorType,
+    /// Writes to read-only entries are acknowledged (and dropped).
+    ReadOnlyWritable,
+    /// Out-of-range writes are acknowledged (and dropped).
+    RangeIgnored,
+    /// ISDU 116 takes effect at once (saved and reset behind the master's back).
+    FormatSwitchImmediate,
+    /// Status bit 7 (temperature) is never reported.
+    TemperatureBitMissing,
+    /// A power cycle loses the saved values (factory settings restored).
+    SavedLostOnPowerCycle,
+    /// The device ID always carries the suffix of format 1.
+    DeviceIdWrongPerFormat,
+    /// Control bit 6 (run without loop) is ignored.
+    NoLoopIgnored,
+    /// ISDU 118 writes are taken as 0 (time-out off).
+    TimeoutIgnored,
+    /// The jog key inputs are not seen.
+    JogKeysIgnored,
+    /// Length overrun and underrun ErrorTypes swapped.
+    LengthErrorsSwapped,
+    /// ISDU 2 values that are no command are acknowledged.
+    CommandValueAccepted,
+    /// Control bit 14 (clear error bits) is ignored.
+    ClearErrorsIgnored,
+    /// Not a deviation: out-of-range writes answered with PAR_VALGTLIM as hex, an ErrorType
+    /// the spec accepts for them (IEC 61131-9 C.2.10).
+    AcceptableVariant,
+    /// ISDU reads of the actual position come 5 steps off: within the motion cases' position
+    /// tolerance, not within the exact ISDU cases.
+    LivePositionOffset,
+}
+
+/// The reference drive with one planted deviation.
+#[derive(Clone)]
+pub struct Mutant<'s> {
+    drive: Drive<'s>,
+    kind: Kind,
+    /// The time stamp armed last (time-stamp mutant).
+    armed: Option<(u8, u16)>,
+}
+
+fn control_bit(drive: &Drive<'_>, name: &str) -> u16 {
+    let b = drive.rules().bitfield("control").unwrap();
+    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
+}
+
+fn status_bit(drive: &Drive<'_>, name: &str) -> u16 {
+    let b = drive.rules().status_bits().unwrap();
+    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
+}
+
+fn int(drive: &Drive<'_>, id: &str) -> i64 {
+    match drive.value(id) {
+        Value::Int(v) => v,
+        other => panic!("{id} is {other:?}"),
+    }
+}
+
+fn error_name(
+    drive: &Drive<'_>,
+    pick: fn(&drivespec_psx3xx::ErrorTypes) -> drivespec_psx3xx::ErrorType,
+) -> String {
+    let rules = drive.rules();
+    rules
+        .error_types()
+        .named(pick(rules.error_known()))
+        .to_string()
+}
+
+impl Mutant<'static> {
+    pub fn new(kind: Kind) -> Mutant<'static> {
+        let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+        Mutant {
+            drive: suite.reference().clone(),
+            kind,
+            armed: None,
+        }
+    }
+}
+
+impl<'s> Mutant<'s> {
+    fn param_of(&self, index: u16, subindex: u8) -> Option<&'s drivespec_spec::Parameter> {
+        match self.drive.rules().isdu_target(index, subindex).ok()? {
+            Target::Entry { param } => Some(param),
+            Target::Record { .. } => None,
+        }
+    }
+
+    fn number(data: &[u8]) -> i64 {
+        data.iter().fold(0i64, |a, b| (a << 8) | i64::from(*b))
+    }
+}
+
+impl<'s> CyclicDevice<'s> for Mutant<'s> {
+    fn cycle(&mut self, now: Micros, image: &[u8]) -> Result<Vec<u8>, String> {
+        let rules = self.drive.rules().clone();
+        let order = self.drive.byte_order();
+        let mut out = Output::parse(&rules, self.drive.active_format(), order, image)
+            .map_err(|e| e.to_string())?;
+        let mut repeated = false;
+        if let Output::TimeStamp { control, stamp } = &mut out {
+            if self.kind == Kind::StampWhileActive && self.armed == Some((control.0, stamp.0)) {
+                *stamp = Stamp::inactive(rules.timestamp());
+                repeated = true;
+            }
+        }
+        let mask = match self.kind {
+            Kind::NoLoopIgnored => control_bit(&self.drive, "Run without loop"),
+            Kind::ClearErrorsIgnored => control_bit(&self.drive, "Clear error bits"),
+            _ => 0,
+        };
+        match &mut out {
+            Output::ControlTarget { control_word, .. } => *control_word &= !mask,
+            Output::SpeedControlTarget {
+                control_word,
+                target_speed,
+                ..
+            } => {
+                *control_word &= !mask;
+                if self.kind == Kind::SpeedZeroNoFallback && *target_speed == 0 {
+                    let half = int(&self.drive, "142") / 2;
+                    *target_speed = i16::try_from(half.max(1)).unwrap();
+                }
+            }
+            Output::TimeStamp { .. } => {}
+        }
+        self.drive
+            .handle_output(now, &out)
+            .map_err(|e| e.to_string())?;
+        let mut last = None;
+        while let Some((_, i)) = self.drive.poll_input() {
+            last = Some(i);
+        }
+        if let (Kind::StampWhileActive, Output::TimeStamp { control, stamp }, false) =
+            (self.kind, out, repeated)
+        {
+            let ts = rules.timestamp();
+            let m = stamp.meaning(ts);
+            if m.is_valid() && !m.is_immediate() {
+                // Armed at once, and a repetition of the same stamp does not re-arm it.
+                self.armed = Some((control.0, stamp.0));
+                let release = Output::TimeStamp {
+                    control,
+                    stamp: Stamp::inactive(ts),
+                };
+                self.drive
+                    .handle_output(now, &release)
+                    .map_err(|e| e.to_string())?;
+                while self.drive.poll_input().is_some() {}
+            } else {
+                self.armed = None;
+            }
+        }
+        let mut input = last.unwrap_or_else(|| self.drive.input());
+        if self.kind == Kind::TemperatureBitMissing {
+            input.status &= !status_bit(&self.drive, "Temperature exceeded");
+        }
+        input.to_bytes(&rules, order).map_err(|e| e.to_string())
+    }
+
+    fn advance(&mut self, now: Micros) {
+        CyclicDevice::advance(&mut self.drive, now);
+    }
+
+    fn isdu(&mut self, now: Micros, req: Request) -> Reply {
+        let rules = self.drive.rules().clone();
+        let (index, subindex) = req.address();
+        let param = self.param_of(index, subindex);
+        let mut req = req;
+        if let Request::Write { data, .. } = &mut req {
+            match self.kind {
+                Kind::GuardIgnored => {
+                    let guards = Guards::from_rules(&rules, &Readings::default()).unwrap();
+                    let hit = guards.guards().iter().any(|g| {
+                        param.is_some_and(|p| {
+                            p.id == g.guard
+                                && p.data_type.width().map(|w| w as usize) == Some(data.len())
+                        }) && Self::number(data) == g.suppress
+                    });
+                    if hit {
+                        return Reply::Written;
+                    }
+                }
+                Kind::ReadOnlyWritable if param.is_some_and(|p| p.access == Access::R) => {
+                    return Reply::Written;
+                }
+                Kind::TimeoutIgnored
+                    if param.is_some_and(|p| p.id == rules.protocol().timeout.timeout_param) =>
+                {
+                    data.iter_mut().for_each(|b| *b = 0);
+                }
+                _ => {}
+            }
+        }
+        let write = matches!(req, Request::Write { .. });
+        let reply = CyclicDevice::isdu(&mut self.drive, now, req);
+        let name = match &reply {
+            Reply::IsduError(n) => n.clone(),
+            _ => String::new(),
+        };
+        match self.kind {
+            Kind::WrongErrorType if name == error_name(&self.drive, |k| k.idx_notavail) => {
+                Reply::IsduError(error_name(&self.drive, |k| k.subidx_notavail))
+            }
+            Kind::LengthErrorsSwapped if name == error_name(&self.drive, |k| k.val_lenovrrun) => {
+                Reply::IsduError(error_name(&self.drive, |k| k.val_lenundrun))
+            }
+            Kind::LengthErrorsSwapped if name == error_name(&self.drive, |k| k.val_lenundrun) => {
+                Reply::IsduError(error_name(&self.drive, |k| k.val_lenovrrun))
+            }
+            Kind::RangeIgnored if name == error_name(&self.drive, |k| k.par_valoutofrng) => {
+                Reply::Written
+            }
+            Kind::CommandValueAccepted if name == error_name(&self.drive, |k| k.func_notavail) => {
+                Reply::Written
+            }
+            Kind::LivePositionOffset
+                if !write && param.is_some_and(|p| p.id == "67") && subindex == 0 =>
+            {
+                match reply {
+                    Reply::Data(d) if d.len() == 4 => {
+                        let v = i32::from_be_bytes([d[0], d[1], d[2], d[3]]) + 5;
+                        Reply::Data(v.to_be_bytes().to_vec())
+                    }
+                    other => other,
+                }
+            }
+            Kind::AcceptableVariant if name == error_name(&self.drive, |k| k.par_valoutofrng) => {
+                let above = rules.error_types().code("PAR_VALGTLIM").unwrap();
+                Reply::IsduError(format!("0x{:04X}", above.0))
+            }
+            Kind::FormatSwitchImmediate
+                if write
+                    && reply == Reply::Written
+                    && param.is_some_and(|p| p.id == rules.protocol().format_select.param) =>
+            {
+                let _ = self.drive.write(now, 2, 0, &Value::Int(161));
+                let _ = self.drive.write(now, 2, 0, &Value::Int(128));
+                while self.drive.poll_isdu().is_some() {}
+                while self.drive.poll_event().is_some() {}
+                reply
+            }
+            Kind::DeviceIdWrongPerFormat
+                if !write && index == rules.protocol().direct_parameters.isdu_index =>
+            {
+                let dp = &rules.protocol().direct_parameters;
+                let entry = dp.entries.iter().find(|e| {
+                    e.name.starts_with("DeviceID") && e.address + dp.subindex_offset == subindex
+                });
+                match (entry, &reply) {
+                    (Some(e), Reply::Data(_)) => {
+                        let code = u32::try_from(int(&self.drive, "79")).unwrap();
+                        let page = rules.direct_page(rules.default_format(), code).unwrap();
+                        Reply::Data(vec![page[usize::from(e.address)]])
+                    }
+                    _ => reply,
+                }
+            }
+            _ => reply,
+        }
+    }
+
+    fn env(&mut self, now: Micros, env: Env) -> bool {
+        match (self.kind, env) {
+            (Kind::JogKeysIgnored, Env::Keys { .. }) => true,
+            (Kind::SavedLostOnPowerCycle, Env::PowerCycle) => {
+                let ok = CyclicDevice::env(&mut self.drive, now, env);
+                let _ = self.drive.write(now, 2, 0, &Value::Int(130));
+                while self.drive.poll_isdu().is_some() {}
+                while self.drive.poll_event().is_some() {}
+                ok
+            }
+            _ => CyclicDevice::env(&mut self.drive, now, env),
+        }
+    }
+
+    fn clone_box(&self) -> Box<dyn CyclicDevice<'s> + 's> {
+        Box::new(self.clone())
+    }
+}
+
+/// A mutant and what it must break.
+pub struct Case {
+    pub kind: Kind,
+    pub name: &'static str,
+    /// Case ID globs of which at least one case each must fail.
+    pub must_fail: &'static [&'static str],
+    /// The requirements the deviation breaks; every failing case must cite one.
+    pub breaks: &'static [&'static str],
+}
+
+/// The mutants the conformance suite and the fuzzer must catch.
+pub fn mutants() -> Vec<Case> {
+    vec![
+        Case {
+            kind: Kind::GuardIgnored,
+            name: "guard entry ignored",
+            must_fail: &["psx3xx/guard/*/suppress"],
+            breaks: &[
+                "PSX-GUARD-66-SUPPRESS",
+                "PSX-GUARD-109-SUPPRESS",
+                "PSX-GUARD-111-SUPPRESS",
+                "PSX-GUARD-126-SUPPRESS",
+                "PSX-GUARD-ONESHOT",
+            ],
+        },
+        Case {
+            kind: Kind::StampWhileActive,
+            name: "time stamp executed while active",
+            must_fail: &["psx3xx/timestamp/not-while-active"],
+            breaks: &["PSX-TS-004", "PSX-TS-005"],
+        },
+        Case {
+            kind: Kind::SpeedZeroNoFallback,
+            name: "8-byte speed 0 not falling back to ISDU 142",
+            must_fail: &["psx3xx/format/2/speed-zero"],
+            breaks: &["PSX-VEL-006"],
+        },
+        Case {
+            kind: Kind::WrongErrorType,
+            name: "wrong ErrorType for unknown indices",
+            must_fail: &["psx3xx/isdu/unknown-index/*"],
+            breaks: &["PSX-DP-ERR-001"],
+        },
+        Case {
+            kind: Kind::ReadOnlyWritable,
+            name: "read-only entries writable",
+            must_fail: &["psx3xx/isdu/read-only/64"],
+            breaks: &["PSX-DP-ERR-003"],
+        },
+        Case {
+            kind: Kind::RangeIgnored,
+            name: "range ignored",
+            must_fail: &["psx3xx/isdu/write/135/above-max", "psx3xx/timeout/reserved"],
+            breaks: &["PSX-DP-ERR-004", "PSX-ISDU-*-RANGE", "PSX-TIMEOUT-007"],
+        },
+        Case {
+            kind: Kind::FormatSwitchImmediate,
+            name: "format switch immediate",
+            must_fail: &["psx3xx/format/0/switch", "psx3xx/format/2/unsaved"],
+            breaks: &["PSX-PD-010", "PSX-DP-008"],
+        },
+        Case {
+            kind: Kind::TemperatureBitMissing,
+            name: "status bit 7 (temperature) missing",
+            must_fail: &["psx3xx/status/temperature"],
+            breaks: &["PSX-STS-7-SET-1"],
+        },
+        Case {
+            kind: Kind::SavedLostOnPowerCycle,
+            name: "saved value lost on power cycle",
+            must_fail: &["psx3xx/command/saved-kept"],
+            breaks: &["PSX-PAR-SAVED", "PSX-CMD-018"],
+        },
+        Case {
+            kind: Kind::DeviceIdWrongPerFormat,
+            name: "device ID wrong per format",
+            must_fail: &["psx3xx/format/0/switch", "psx3xx/format/2/switch"],
+            breaks: &["PSX-DP-007"],
+        },
+        Case {
+            kind: Kind::NoLoopIgnored,
+            name: "control bit 6 (no loop) ignored",
+            must_fail: &["psx3xx/position/no-loop-down"],
+            breaks: &["PSX-CMD-008", "PSX-RUN-007", "PSX-TS-012"],
+        },
+        Case {
+            kind: Kind::TimeoutIgnored,
+            name: "ISDU 118 time-out ignored",
+            must_fail: &["psx3xx/timeout/cancel", "psx3xx/timeout/safe-position"],
+            breaks: &[
+                "PSX-TIMEOUT-003",
+                "PSX-TIMEOUT-004",
+                "PSX-TIMEOUT-005",
+                "PSX-ISDU-118-RANGE",
+            ],
+        },
+        Case {
+            kind: Kind::JogKeysIgnored,
+            name: "jog keys ignored",
+            must_fail: &["psx3xx/status/jog-keys", "psx3xx/position/jog-step"],
+            breaks: &[
+                "PSX-STS-2-SET-1",
+                "PSX-STS-3-SET-1",
+                "PSX-JOG-005",
+                "PSX-JOG-006",
+                "PSX-JOG-010",
+            ],
+        },
+        Case {
+            kind: Kind::LengthErrorsSwapped,
+            name: "length overrun and underrun swapped",
+            must_fail: &["psx3xx/isdu/length/*/overrun"],
+            breaks: &["PSX-DP-ERR-006"],
+        },
+        Case {
+            kind: Kind::CommandValueAccepted,
+            name: "ISDU 2 accepts values that are no command",
+            must_fail: &["psx3xx/command/2/invalid-*"],
+            breaks: &["PSX-DP-ERR-005"],
+        },
+        Case {
+            kind: Kind::ClearErrorsIgnored,
+            name: "control bit 14 (clear error bits) ignored",
+            must_fail: &["psx3xx/status/release-withdrawn"],
+            breaks: &["PSX-CTL-14-1", "PSX-STS-5-RESET-2"],
+        },
+    ]
+}
