@@ -19,6 +19,7 @@
 //! both over the cyclic-exchange protocol; each implements the crate-internal `Target`
 //! (`engine.rs`) with its generator and the family's conformance session.
 
+mod cyclic_target;
 mod ddmin;
 mod engine;
 mod hpd;

@@ -13,11 +13,12 @@
 //! closed), a hang when the device sent no reply within the protocol's time-out (2 s), and a
 //! mismatch otherwise; the signature names the step kind and the fields that differ.
 
-use super::engine::{self, Fault, Target, Trial};
+use super::cyclic_target;
+use super::engine::{self, Target, Trial};
 use super::psd4xx_gen::{env_kind, PsdGen, ENV_KINDS};
-use super::replay::{Action, CyclicStep, FindingClass, Start, Step};
-use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
-use crate::cyclic::{Peer, PeerError};
+use super::replay::{Action, CyclicStep, Start, Step};
+use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
+use crate::cyclic::Peer;
 use crate::link::{Caps, LinkError};
 use crate::psd4xx::gen::{self, PsdCase, StepDef, EXCHANGE, MOTION};
 use crate::psd4xx::{Psd4xxSession, Psd4xxSuite};
@@ -145,39 +146,17 @@ impl<'a, 's> Psd4xxTarget<'a, 's> {
     }
 }
 
-/// Most cycles one `hold` or `until` step runs (10 min of bus time at 10 ms): a replay file
-/// cannot make a run endless.
-const MAX_STEP_CYCLES: u32 = 60_000;
-
-/// Longest `advance` step (10 min).
-const MAX_ADVANCE_US: u64 = 600_000_000;
-
-/// What kind of step a fuzz step is, for signatures.
-fn kind(s: Option<&Step>) -> String {
-    match s.map(|s| &s.action) {
-        Some(Action::Cyclic(CyclicStep::Pkw { ak, .. })) => format!("pkw-ak{ak}"),
-        Some(Action::Cyclic(CyclicStep::Env(env))) => {
-            let text = env.to_string();
-            format!("env-{}", text.split(' ').next().unwrap_or("?"))
-        }
-        Some(Action::Cyclic(c)) => match c {
-            CyclicStep::Process { .. } => "process",
-            CyclicStep::Offset { .. } => "offset",
-            CyclicStep::Hold { .. } => "hold",
-            CyclicStep::Until { .. } => "until",
-            CyclicStep::RecordRead { .. } => "record-read",
-            CyclicStep::RecordWrite { .. } => "record-write",
-            CyclicStep::Advance { .. } => "advance",
-            CyclicStep::Pkw { .. }
-            | CyclicStep::Env(_)
-            | CyclicStep::ProcessData { .. }
-            | CyclicStep::IsduRead { .. }
-            | CyclicStep::IsduWrite { .. } => "cyclic",
-        }
-        .to_owned(),
-        Some(_) => "not-cyclic".to_owned(),
-        None => "start".to_owned(),
-    }
+/// The signature names of the PSD4xx steps ([`cyclic_target::kind`] names the shared ones).
+fn own_kind(c: &CyclicStep) -> Option<String> {
+    let name = match c {
+        CyclicStep::Pkw { ak, .. } => return Some(format!("pkw-ak{ak}")),
+        CyclicStep::Process { .. } => "process",
+        CyclicStep::Offset { .. } => "offset",
+        CyclicStep::RecordRead { .. } => "record-read",
+        CyclicStep::RecordWrite { .. } => "record-write",
+        _ => return None,
+    };
+    Some(name.to_owned())
 }
 
 /// A fuzz step as a conformance step (judged). Steps of other protocols never reach here
@@ -206,10 +185,12 @@ fn to_case_step(s: &Step) -> StepDef {
                 ind: *ind,
                 pwe: *pwe,
             }),
-            CyclicStep::Hold { cycles } => gen::Action::Hold((*cycles).min(MAX_STEP_CYCLES)),
+            CyclicStep::Hold { cycles } => {
+                gen::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
+            }
             CyclicStep::Until { running, max } => gen::Action::Until {
                 running: *running,
-                max: (*max).min(MAX_STEP_CYCLES),
+                max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
             },
             CyclicStep::RecordRead { index } => {
                 gen::Action::Record(RecordRequest::Read { index: *index })
@@ -219,7 +200,9 @@ fn to_case_step(s: &Step) -> StepDef {
                 data: data.clone(),
             }),
             CyclicStep::Env(env) => gen::Action::Env(*env),
-            CyclicStep::Advance { us } => gen::Action::Advance((*us).min(MAX_ADVANCE_US)),
+            CyclicStep::Advance { us } => {
+                gen::Action::Advance((*us).min(cyclic_target::MAX_ADVANCE_US))
+            }
             CyclicStep::ProcessData { .. }
             | CyclicStep::IsduRead { .. }
             | CyclicStep::IsduWrite { .. } => gen::Action::Hold(1),
@@ -243,14 +226,7 @@ impl Target for Psd4xxTarget<'_, '_> {
     }
 
     fn caps(&self) -> Caps {
-        // Every run starts with `RESET` on the device and a fresh reference, on any transport;
-        // times are virtual (carried in the requests).
-        Caps {
-            reset: true,
-            power_cycle: true,
-            virtual_time: true,
-            inputs: false,
-        }
+        cyclic_target::CAPS
     }
 
     fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
@@ -266,43 +242,16 @@ impl Target for Psd4xxTarget<'_, '_> {
 
     fn run(&mut self, steps: &[Step]) -> Trial {
         let (info, case) = self.case(steps);
-        let mut run = self.session.run_case(&info, &case);
+        let run = self.session.run_case(&info, &case);
         let peer_error = self.session.take_peer_error();
-        let Outcome::Fail(mut failure) = run.outcome.clone() else {
-            return Trial { run, fault: None };
-        };
-        let step = failure.step.unwrap_or(0);
-        let (class, detail) = match &peer_error {
-            Some(PeerError::Timeout { .. }) => (FindingClass::Hang, String::new()),
-            Some(PeerError::Link(_)) => (FindingClass::Crash, String::new()),
-            Some(PeerError::Garbage { .. }) => (FindingClass::Mismatch, "/garbage".to_owned()),
-            None => (
-                FindingClass::Mismatch,
-                format!("/{}", self.differs(&run, step)),
-            ),
-        };
-        // The failing step's requirements, not the whole sequence's.
-        if let Some(s) = steps.get(step) {
-            failure.requirements = s
-                .requirements
-                .iter()
-                .filter_map(|id| self.requirement(id))
-                .collect();
-        }
-        if let Some(e) = &peer_error {
-            failure.message = format!("{} ({e})", failure.message);
-        }
-        run.outcome = Outcome::Fail(failure.clone());
-        let signature = format!("{}/{}{detail}", class.as_str(), kind(steps.get(step)));
-        Trial {
+        cyclic_target::trial(
             run,
-            fault: Some(Fault {
-                class,
-                step,
-                signature,
-                failure,
-            }),
-        }
+            peer_error,
+            steps,
+            self.suite.family(),
+            own_kind,
+            |run, step| self.differs(run, step),
+        )
     }
 
     fn requirement(&self, id: &str) -> Option<RequirementRef> {

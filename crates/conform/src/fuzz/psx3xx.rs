@@ -13,11 +13,12 @@
 //! closed), a hang when the device sent no reply within the protocol's time-out (2 s), and a
 //! mismatch otherwise; the signature names the step kind and what differs.
 
-use super::engine::{self, Fault, Target, Trial};
+use super::cyclic_target;
+use super::engine::{self, Target, Trial};
 use super::psx3xx_gen::{PsxGen, ENV_KINDS};
-use super::replay::{Action, CyclicStep, FindingClass, Start, Step};
-use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
-use crate::cyclic::{Peer, PeerError};
+use super::replay::{Action, CyclicStep, Start, Step};
+use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
+use crate::cyclic::Peer;
 use crate::link::{Caps, LinkError};
 use crate::psx3xx::gen::{self, PsxCase, StepDef, EXACT, MOTION};
 use crate::psx3xx::{Psx3xxSession, Psx3xxSuite};
@@ -154,12 +155,6 @@ impl<'a, 's> Psx3xxTarget<'a, 's> {
     }
 }
 
-/// Most cycles one `hold` or `until` step runs: a replay file cannot make a run endless.
-const MAX_STEP_CYCLES: u32 = 60_000;
-
-/// Longest `advance` step (10 min).
-const MAX_ADVANCE_US: u64 = 600_000_000;
-
 /// The all-zero output of a format (format 0: the stamp inactive).
 fn idle(suite: &Psx3xxSuite<'_>, format: u8) -> Output {
     let inactive = Stamp::inactive(suite.reference().rules().timestamp());
@@ -185,29 +180,13 @@ fn output(format: u8, control: u16, target: i32, speed: i16, stamp: u16) -> Outp
     }
 }
 
-/// What kind of step a fuzz step is, for signatures.
-fn kind(s: Option<&Step>) -> String {
-    match s.map(|s| &s.action) {
-        Some(Action::Cyclic(CyclicStep::ProcessData { format, .. })) => {
-            format!("pd-format-{format}")
-        }
-        Some(Action::Cyclic(CyclicStep::IsduRead { index, .. })) => format!("isdu-read-{index}"),
-        Some(Action::Cyclic(CyclicStep::IsduWrite { index, .. })) => {
-            format!("isdu-write-{index}")
-        }
-        Some(Action::Cyclic(CyclicStep::Env(env))) => {
-            let text = env.to_string();
-            format!("env-{}", text.split(' ').next().unwrap_or("?"))
-        }
-        Some(Action::Cyclic(c)) => match c {
-            CyclicStep::Hold { .. } => "hold",
-            CyclicStep::Until { .. } => "until",
-            CyclicStep::Advance { .. } => "advance",
-            _ => "cyclic",
-        }
-        .to_owned(),
-        Some(_) => "not-cyclic".to_owned(),
-        None => "start".to_owned(),
+/// The signature names of the PSx3xx steps ([`cyclic_target::kind`] names the shared ones).
+fn own_kind(c: &CyclicStep) -> Option<String> {
+    match c {
+        CyclicStep::ProcessData { format, .. } => Some(format!("pd-format-{format}")),
+        CyclicStep::IsduRead { index, .. } => Some(format!("isdu-read-{index}")),
+        CyclicStep::IsduWrite { index, .. } => Some(format!("isdu-write-{index}")),
+        _ => None,
     }
 }
 
@@ -236,13 +215,17 @@ fn to_case_step(s: &Step) -> StepDef {
                 subindex: *subindex,
                 data: data.clone(),
             }),
-            CyclicStep::Hold { cycles } => gen::Action::Hold((*cycles).min(MAX_STEP_CYCLES)),
+            CyclicStep::Hold { cycles } => {
+                gen::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
+            }
             CyclicStep::Until { running, max } => gen::Action::Until {
                 running: *running,
-                max: (*max).min(MAX_STEP_CYCLES),
+                max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
             },
             CyclicStep::Env(env) => gen::Action::Env(*env),
-            CyclicStep::Advance { us } => gen::Action::Silence((*us).min(MAX_ADVANCE_US)),
+            CyclicStep::Advance { us } => {
+                gen::Action::Silence((*us).min(cyclic_target::MAX_ADVANCE_US))
+            }
             CyclicStep::Process { .. }
             | CyclicStep::Offset { .. }
             | CyclicStep::Pkw { .. }
@@ -268,14 +251,7 @@ impl Target for Psx3xxTarget<'_, '_> {
     }
 
     fn caps(&self) -> Caps {
-        // Every run starts with `RESET` on the device and a fresh reference, on any transport;
-        // times are virtual (carried in the requests).
-        Caps {
-            reset: true,
-            power_cycle: true,
-            virtual_time: true,
-            inputs: false,
-        }
+        cyclic_target::CAPS
     }
 
     fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
@@ -291,46 +267,16 @@ impl Target for Psx3xxTarget<'_, '_> {
 
     fn run(&mut self, steps: &[Step]) -> Trial {
         let (info, case) = self.case(steps);
-        let mut run = self.session.run_case(&info, &case);
+        let run = self.session.run_case(&info, &case);
         let peer_error = self.session.take_peer_error();
-        let Outcome::Fail(mut failure) = run.outcome.clone() else {
-            return Trial { run, fault: None };
-        };
-        let step = failure.step.unwrap_or(0);
-        let (class, detail) = match &peer_error {
-            Some(PeerError::Timeout { .. }) => (FindingClass::Hang, String::new()),
-            Some(PeerError::Link(_)) => (FindingClass::Crash, String::new()),
-            Some(PeerError::Garbage { .. }) => (FindingClass::Mismatch, "/garbage".to_owned()),
-            None if failure.message.starts_with("the exchange failed") => {
-                (FindingClass::Mismatch, "/exchange".to_owned())
-            }
-            None => (
-                FindingClass::Mismatch,
-                format!("/{}", self.differs(&run, step)),
-            ),
-        };
-        // The failing step's requirements, not the whole sequence's.
-        if let Some(s) = steps.get(step) {
-            failure.requirements = s
-                .requirements
-                .iter()
-                .filter_map(|id| self.requirement(id))
-                .collect();
-        }
-        if let Some(e) = &peer_error {
-            failure.message = format!("{} ({e})", failure.message);
-        }
-        run.outcome = Outcome::Fail(failure.clone());
-        let signature = format!("{}/{}{detail}", class.as_str(), kind(steps.get(step)));
-        Trial {
+        cyclic_target::trial(
             run,
-            fault: Some(Fault {
-                class,
-                step,
-                signature,
-                failure,
-            }),
-        }
+            peer_error,
+            steps,
+            self.suite.family(),
+            own_kind,
+            |run, step| self.differs(run, step),
+        )
     }
 
     fn requirement(&self, id: &str) -> Option<RequirementRef> {
