@@ -3,7 +3,7 @@
 //!
 //! These types are the JSON report's vocabulary (`REPORTS.md`): fields are only ever added.
 
-use drivespec_spec::{FamilyId, Level};
+use drivespec_spec::{Family, FamilyId, Level};
 use serde::Serialize;
 
 /// A conformance case as the runner, `--list` and the reports see it.
@@ -32,6 +32,17 @@ pub struct RequirementRef {
     pub level: Level,
     /// The requirement in the spec's words.
     pub text: String,
+}
+
+impl RequirementRef {
+    /// The requirement `id` of `family` with its level and text; None when the spec lacks it.
+    pub(crate) fn of(family: &Family, id: &str) -> Option<RequirementRef> {
+        family.requirement(id).map(|r| RequirementRef {
+            id: r.id.clone(),
+            level: r.level,
+            text: r.text.clone(),
+        })
+    }
 }
 
 /// Why a case failed.

@@ -8,9 +8,11 @@
 //! - [`wire`]: the request and reply lines, parsed and printed.
 //! - [`server`]: the device side for the built-in reference models (and test wrappers).
 //! - [`peer`]: the runner side: in-process (`sim`) or over a link.
+//! - `device`: a peer as a conformance session holds it (greeting, restarts, failures).
 //!
 //! Nothing here panics on any line; every wait on a remote peer is bounded.
 
+pub(crate) mod device;
 pub mod peer;
 pub mod server;
 pub mod wire;

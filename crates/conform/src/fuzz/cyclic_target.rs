@@ -2,9 +2,9 @@
 //! capabilities, the bounds a replay file cannot exceed, the signature of a step and how a
 //! failed case run becomes a finding (README "Cyclic-exchange protocol", "Fuzzing").
 
-use super::engine::{self, Fault, Trial};
+use super::engine::{Fault, Trial};
 use super::replay::{Action, CyclicStep, FindingClass, Step};
-use crate::case::{CaseRun, Outcome};
+use crate::case::{CaseRun, Outcome, RequirementRef};
 use crate::cyclic::PeerError;
 use crate::link::Caps;
 use drivespec_spec::Family;
@@ -78,7 +78,7 @@ pub(super) fn trial(
         failure.requirements = s
             .requirements
             .iter()
-            .filter_map(|id| engine::requirement_ref(family, id))
+            .filter_map(|id| RequirementRef::of(family, id))
             .collect();
     }
     if let Some(e) = &peer_error {

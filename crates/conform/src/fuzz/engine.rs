@@ -438,15 +438,6 @@ pub(crate) fn is_exchange(s: &Step) -> bool {
     )
 }
 
-/// A requirement of `family` with its text, for reports ([`Target::requirement`]).
-pub(crate) fn requirement_ref(family: &Family, id: &str) -> Option<RequirementRef> {
-    family.requirement(id).map(|r| RequirementRef {
-        id: r.id.clone(),
-        level: r.level,
-        text: r.text.clone(),
-    })
-}
-
 /// Every must/should requirement ID of `family`, in spec order ([`Target::requirement_ids`]).
 pub(crate) fn requirement_ids(family: &Family) -> Vec<(String, Level)> {
     family

@@ -300,7 +300,7 @@ impl Target for HpdTarget<'_, '_> {
     }
 
     fn requirement(&self, id: &str) -> Option<RequirementRef> {
-        engine::requirement_ref(self.family, id)
+        RequirementRef::of(self.family, id)
     }
 
     fn requirement_ids(&self) -> Vec<(String, Level)> {

@@ -255,7 +255,7 @@ impl Target for Psd4xxTarget<'_, '_> {
     }
 
     fn requirement(&self, id: &str) -> Option<RequirementRef> {
-        engine::requirement_ref(self.suite.family(), id)
+        RequirementRef::of(self.suite.family(), id)
     }
 
     fn requirement_ids(&self) -> Vec<(String, Level)> {

@@ -304,12 +304,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             }
         }
         ids.into_iter()
-            .filter_map(|id| family.requirement(&id))
-            .map(|r| RequirementRef {
-                id: r.id.clone(),
-                level: r.level,
-                text: r.text.clone(),
-            })
+            .filter_map(|id| RequirementRef::of(family, &id))
             .collect()
     }
 }

@@ -4,8 +4,9 @@
 use super::gen::{status_bit, Action, PsdCase, Tolerance, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::cyclic::device::Device;
 use crate::cyclic::wire::hex;
-use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server, VERSION};
+use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server};
 use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psd4xx::model::RecordRequest;
@@ -15,9 +16,9 @@ use drivespec_spec::FamilyId;
 /// A session on one device under test.
 pub struct Psd4xxSession<'a, 's> {
     suite: &'a Psd4xxSuite<'s>,
-    peer: Box<dyn Peer>,
-    /// The first transport failure of the case run last (a crash or hang to the fuzzer).
-    peer_error: Option<PeerError>,
+    /// The device under test; its first transport failure of a case run is a crash or hang
+    /// to the fuzzer.
+    device: Device<'a>,
 }
 
 /// One cycle as both sides saw it.
@@ -43,74 +44,29 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
     pub(crate) fn new(suite: &'a Psd4xxSuite<'s>, peer: Box<dyn Peer>) -> Psd4xxSession<'a, 's> {
         Psd4xxSession {
             suite,
-            peer,
-            peer_error: None,
+            device: Device::new(peer, FamilyId::Psd4xx, suite.model()),
         }
     }
 
     /// Exchanges `HELLO`; an error names what the device side said.
     pub fn hello(&mut self) -> Result<String, String> {
-        let req = Request::Hello {
-            version: VERSION,
-            family: FamilyId::Psd4xx.as_str().to_owned(),
-            model: self.suite.model().to_owned(),
-        };
-        match self.peer.call(&req) {
-            Ok(Reply::Hello { version, name }) if version == VERSION => Ok(name),
-            Ok(other) => Err(format!(
-                "{}: HELLO answered with {other:?} (expected HELLO drivespec-cyclic {VERSION} …)",
-                self.peer.describe()
-            )),
-            Err(e) => Err(format!("{}: {e}", self.peer.describe())),
-        }
+        self.device.hello()
     }
 
     /// The first transport failure of the case run last, if any (taken).
     pub(crate) fn take_peer_error(&mut self) -> Option<PeerError> {
-        self.peer_error.take()
+        self.device.take_error()
     }
 
-    /// Whether the device takes the injection `env` (`ENV` answered `OK`; the injections are
-    /// optional, README "Cyclic-exchange protocol"). The device is reset after it; a transport
-    /// failure counts as no (and the device is restarted).
+    /// Whether the device takes the injection `env` ([`Device::takes`]).
     pub(crate) fn takes(&mut self, env: Env) -> bool {
-        let ok = match self.peer.call(&Request::Env { t: 0, env }) {
-            Ok(r) => r == Reply::Ok,
-            Err(_) => {
-                self.restart();
-                return false;
-            }
-        };
-        if self.peer.call(&Request::Reset).is_err() {
-            self.restart();
-        }
-        ok
-    }
-
-    /// Notes a transport failure, then reconnects or restarts the peer and greets it again.
-    fn failed(&mut self, e: &PeerError) {
-        if self.peer_error.is_none() {
-            self.peer_error = Some(e.clone());
-        }
-        self.restart();
-    }
-
-    /// After a transport error: reconnect or restart the peer and greet it again.
-    fn restart(&mut self) {
-        if self.peer.recover().is_ok() {
-            let _ = self.hello();
-        }
+        self.device.takes(env)
     }
 
     fn refs(&self, ids: &[String]) -> Vec<RequirementRef> {
         let family = self.suite.family();
         ids.iter()
-            .filter_map(|id| family.requirement(id))
-            .map(|r| RequirementRef {
-                id: r.id.clone(),
-                level: r.level,
-                text: r.text.clone(),
-            })
+            .filter_map(|id| RequirementRef::of(family, id))
             .collect()
     }
 
@@ -183,10 +139,10 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
         let image = run.out.to_bytes(rules).map_err(|e| e.to_string())?;
         let req = Request::Cycle { t: run.t, image };
         let reference = self.parse_input(&run.reference.handle(req.clone()))?;
-        let dut = match self.peer.call(&req) {
+        let dut = match self.device.call(&req) {
             Ok(r) => self.parse_input(&r),
             Err(e) => {
-                self.failed(&e);
+                self.device.failed(&e);
                 run.cycles.push(Cycle {
                     step,
                     t: run.t,
@@ -219,10 +175,10 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
         req: Request,
     ) -> bool {
         let expected = run.reference.handle(req.clone());
-        let got = match self.peer.call(&req) {
+        let got = match self.device.call(&req) {
             Ok(r) => r.to_string(),
             Err(e) => {
-                self.failed(&e);
+                self.device.failed(&e);
                 format!("error: {e}")
             }
         };
@@ -477,7 +433,7 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
     /// Runs one case (a generated one, or a fuzz sequence) against the device and a fresh
     /// reference.
     pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &PsdCase) -> CaseRun {
-        self.peer_error = None;
+        self.device.clear_error();
         let rules = self.suite.reference().rules();
         let mut run = Run {
             reference: self.suite.server(),
@@ -488,11 +444,11 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
             failure: None,
             reqs: &info.requirements,
         };
-        let reset_ok = match self.peer.call(&Request::Reset) {
+        let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),
             Ok(other) => Err(format!("RESET answered with {other}")),
             Err(e) => {
-                self.failed(&e);
+                self.device.failed(&e);
                 Err(e.to_string())
             }
         };
@@ -566,7 +522,7 @@ impl<'a, 's> Psd4xxSession<'a, 's> {
 
 impl Session for Psd4xxSession<'_, '_> {
     fn describe(&self) -> String {
-        self.peer.describe()
+        self.device.describe()
     }
 
     fn run(&mut self, index: usize) -> CaseRun {

@@ -4,8 +4,9 @@
 use super::gen::{Action, PsxCase, Tolerance};
 use super::Psx3xxSuite;
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::cyclic::device::Device;
 use crate::cyclic::wire::hex;
-use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server, VERSION};
+use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server};
 use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psx3xx::isdu::{ErrorType, Request as IsduRequest};
@@ -15,13 +16,12 @@ use drivespec_spec::FamilyId;
 /// A session on one device under test.
 pub struct Psx3xxSession<'a, 's> {
     suite: &'a Psx3xxSuite<'s>,
-    peer: Box<dyn Peer + 'a>,
+    /// The device under test.
+    device: Device<'a>,
     running_bit: u16,
     /// ISDU indices of the live speed and position (3.3.2 `rpm`, `actual`), judged within
     /// the case's speed and position tolerance.
     live: Vec<(u16, Live)>,
-    /// The first transport failure of the case run last.
-    peer_error: Option<PeerError>,
 }
 
 /// Which tolerance a live ISDU value gets.
@@ -91,76 +91,31 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
             .collect();
         Psx3xxSession {
             suite,
-            peer,
+            device: Device::new(peer, FamilyId::Psx3xx, suite.model()),
             running_bit,
             live,
-            peer_error: None,
         }
     }
 
     /// Exchanges `HELLO`; an error names what the device side said.
     pub fn hello(&mut self) -> Result<String, String> {
-        let req = Request::Hello {
-            version: VERSION,
-            family: FamilyId::Psx3xx.as_str().to_owned(),
-            model: self.suite.model().to_owned(),
-        };
-        match self.peer.call(&req) {
-            Ok(Reply::Hello { version, name }) if version == VERSION => Ok(name),
-            Ok(other) => Err(format!(
-                "{}: HELLO answered with {other:?} (expected HELLO drivespec-cyclic {VERSION} …)",
-                self.peer.describe()
-            )),
-            Err(e) => Err(format!("{}: {e}", self.peer.describe())),
-        }
+        self.device.hello()
     }
 
     /// The first transport failure of the case run last, if any (taken).
     pub(crate) fn take_peer_error(&mut self) -> Option<PeerError> {
-        self.peer_error.take()
+        self.device.take_error()
     }
 
-    /// Whether the device takes the injection `env` (`ENV` answered `OK`; the injections are
-    /// optional, README "Cyclic-exchange protocol"). The device is reset after it; a transport
-    /// failure counts as no (and the device is restarted).
+    /// Whether the device takes the injection `env` ([`Device::takes`]).
     pub(crate) fn takes(&mut self, env: Env) -> bool {
-        let ok = match self.peer.call(&Request::Env { t: 0, env }) {
-            Ok(r) => r == Reply::Ok,
-            Err(_) => {
-                self.restart();
-                return false;
-            }
-        };
-        if self.peer.call(&Request::Reset).is_err() {
-            self.restart();
-        }
-        ok
-    }
-
-    /// Notes a transport failure, then reconnects or restarts the peer and greets it again.
-    fn failed(&mut self, e: &PeerError) {
-        if self.peer_error.is_none() {
-            self.peer_error = Some(e.clone());
-        }
-        self.restart();
-    }
-
-    /// After a transport error: reconnect or restart the peer and greet it again.
-    fn restart(&mut self) {
-        if self.peer.recover().is_ok() {
-            let _ = self.hello();
-        }
+        self.device.takes(env)
     }
 
     fn refs(&self, ids: &[String]) -> Vec<RequirementRef> {
         let family = self.suite.family();
         ids.iter()
-            .filter_map(|id| family.requirement(id))
-            .map(|r| RequirementRef {
-                id: r.id.clone(),
-                level: r.level,
-                text: r.text.clone(),
-            })
+            .filter_map(|id| RequirementRef::of(family, id))
             .collect()
     }
 
@@ -192,10 +147,10 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
         let image = self.image(&run.out)?;
         let req = Request::Cycle { t: run.t, image };
         let reference = self.parse_input(&run.reference.handle(req.clone()))?;
-        let dut = match self.peer.call(&req) {
+        let dut = match self.device.call(&req) {
             Ok(r) => self.parse_input(&r),
             Err(e) => {
-                self.failed(&e);
+                self.device.failed(&e);
                 run.cycles.push(Cycle {
                     step,
                     t: run.t,
@@ -303,13 +258,13 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
         req: Request,
     ) -> bool {
         let expected = run.reference.handle(req.clone());
-        let (got, got_text) = match self.peer.call(&req) {
+        let (got, got_text) = match self.device.call(&req) {
             Ok(r) => {
                 let t = r.to_string();
                 (Some(r), t)
             }
             Err(e) => {
-                self.failed(&e);
+                self.device.failed(&e);
                 (None, format!("error: {e}"))
             }
         };
@@ -535,7 +490,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
     }
 
     pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &PsxCase) -> CaseRun {
-        self.peer_error = None;
+        self.device.clear_error();
         let mut run = Run {
             reference: self.suite.server(),
             tol: case.tol,
@@ -547,11 +502,11 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
             failure: None,
             reqs: &info.requirements,
         };
-        let reset_ok = match self.peer.call(&Request::Reset) {
+        let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),
             Ok(other) => Err(format!("RESET answered with {other}")),
             Err(e) => {
-                self.failed(&e);
+                self.device.failed(&e);
                 Err(e.to_string())
             }
         };
@@ -643,7 +598,7 @@ fn out_text(out: &Output) -> String {
 
 impl Session for Psx3xxSession<'_, '_> {
     fn describe(&self) -> String {
-        self.peer.describe()
+        self.device.describe()
     }
 
     fn run(&mut self, index: usize) -> CaseRun {
