@@ -9,19 +9,22 @@ use drivespec_capture::profinet::{Events, PnEvent, PnEventKind};
 use drivespec_capture::rt::{ApduStatus, DataStatus, FrameId};
 use drivespec_capture::serial::SerialReader;
 use drivespec_capture::CaptureReader;
-use drivespec_check::profinet::{Manual, PnOptions};
+use drivespec_check::hpd::HpdChecker;
+use drivespec_check::iolink::IoLinkChecker;
+use drivespec_check::profinet::{Manual, PnChecker, PnOptions};
 use drivespec_check::{Catalog, Report};
 use drivespec_spec::Spec;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 fn spec() -> &'static Spec {
     static SPEC: OnceLock<Spec> = OnceLock::new();
     SPEC.get_or_init(|| Spec::builtin().expect("the built-in spec loads"))
 }
 
-fn catalog() -> &'static Catalog {
-    static CATALOG: OnceLock<Catalog> = OnceLock::new();
-    CATALOG.get_or_init(|| Catalog::new(spec()).expect("the catalogue builds"))
+/// Built once: every checker of a run shares it, as `drivespec check` does over its files.
+fn catalog() -> &'static Arc<Catalog> {
+    static CATALOG: OnceLock<Arc<Catalog>> = OnceLock::new();
+    CATALOG.get_or_init(|| Arc::new(Catalog::new(spec()).expect("the catalogue builds")))
 }
 
 /// The invariants of every report.
@@ -50,7 +53,9 @@ pub fn hpd(data: &[u8]) {
         baud: Some(8),
         max_violations: Some(16),
     };
-    let r = drivespec_check::hpd::check(spec(), &options, reader).expect("setup");
+    let r = HpdChecker::with_catalog(spec(), &options, catalog().clone())
+        .expect("setup")
+        .run(reader);
     consistent(&r);
 }
 
@@ -67,7 +72,9 @@ pub fn profinet(data: &[u8]) {
         max_violations: Some(16),
         ..PnOptions::default()
     };
-    let r = drivespec_check::profinet::check(spec(), pn, Events::new(reader)).expect("setup");
+    let r = PnChecker::with_catalog(spec(), pn, catalog().clone())
+        .expect("setup")
+        .run(Events::new(reader));
     consistent(&r);
 }
 
@@ -80,7 +87,9 @@ pub fn iolink(data: &[u8]) {
         max_violations: Some(16),
         ..Default::default()
     };
-    let r = drivespec_check::iolink::check(spec(), options, reader).expect("setup");
+    let r = IoLinkChecker::with_catalog(spec(), options, catalog().clone())
+        .expect("setup")
+        .run(reader);
     consistent(&r);
 }
 
@@ -125,6 +134,8 @@ pub fn psd4xx(data: &[u8]) {
             },
         })
     });
-    let r = drivespec_check::profinet::check(spec(), pn, events).expect("setup");
+    let r = PnChecker::with_catalog(spec(), pn, catalog().clone())
+        .expect("setup")
+        .run(events);
     consistent(&r);
 }

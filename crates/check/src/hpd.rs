@@ -150,6 +150,24 @@ impl<'s> HpdChecker<'s> {
         HpdChecker::with_catalog(spec, options, catalog)
     }
 
+    /// Checks every item of `chunks` in order (see [`check`]) and gives the report.
+    pub fn run<I>(mut self, chunks: I) -> Report
+    where
+        I: IntoIterator<Item = Result<SerialChunk, SerialError>>,
+    {
+        for item in chunks {
+            match item {
+                Ok(chunk) => self.push(&chunk),
+                Err(e) if continues(&e) => self.skipped(&e),
+                Err(e) => {
+                    self.fail(&e);
+                    break;
+                }
+            }
+        }
+        self.finish()
+    }
+
     /// A checker sharing a catalogue.
     pub fn with_catalog(
         spec: &'s Spec,
@@ -987,18 +1005,7 @@ pub fn check<I>(spec: &Spec, options: &HpdOptions, chunks: I) -> Result<Report, 
 where
     I: IntoIterator<Item = Result<SerialChunk, SerialError>>,
 {
-    let mut c = HpdChecker::new(spec, options)?;
-    for item in chunks {
-        match item {
-            Ok(chunk) => c.push(&chunk),
-            Err(e) if continues(&e) => c.skipped(&e),
-            Err(e) => {
-                c.fail(&e);
-                break;
-            }
-        }
-    }
-    Ok(c.finish())
+    Ok(HpdChecker::new(spec, options)?.run(chunks))
 }
 
 /// Whether the serial reader goes on after this error (module doc of `capture::serial`).

@@ -233,6 +233,24 @@ impl<'s> IoLinkChecker<'s> {
         IoLinkChecker::with_catalog(spec, options, catalog)
     }
 
+    /// Checks every item of `events` in order (see [`check`]) and gives the report.
+    pub fn run<I>(mut self, events: I) -> Report
+    where
+        I: IntoIterator<Item = Result<IoLinkEvent, IoLinkError>>,
+    {
+        for item in events {
+            match item {
+                Ok(ev) => self.push(&ev),
+                Err(e) if continues(&e) => self.skipped(&e),
+                Err(e) => {
+                    self.fail(&e);
+                    break;
+                }
+            }
+        }
+        self.finish()
+    }
+
     /// A checker sharing a catalogue.
     pub fn with_catalog(
         spec: &'s Spec,
@@ -907,18 +925,7 @@ pub fn check<I>(spec: &Spec, options: PsxOptions, events: I) -> Result<Report, S
 where
     I: IntoIterator<Item = Result<IoLinkEvent, IoLinkError>>,
 {
-    let mut c = IoLinkChecker::new(spec, options)?;
-    for item in events {
-        match item {
-            Ok(ev) => c.push(&ev),
-            Err(e) if continues(&e) => c.skipped(&e),
-            Err(e) => {
-                c.fail(&e);
-                break;
-            }
-        }
-    }
-    Ok(c.finish())
+    Ok(IoLinkChecker::new(spec, options)?.run(events))
 }
 
 /// Whether a run seen starting at log time `t` came before its time stamp allowed

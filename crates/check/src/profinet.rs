@@ -252,6 +252,23 @@ impl<'s> PnChecker<'s> {
         PnChecker::with_catalog(spec, options, catalog)
     }
 
+    /// Checks every item of `events` in order (see [`check`]) and gives the report.
+    pub fn run<I>(mut self, events: I) -> Report
+    where
+        I: IntoIterator<Item = Result<PnEvent, CaptureError>>,
+    {
+        for item in events {
+            match item {
+                Ok(ev) => self.push(&ev),
+                Err(e) => {
+                    self.fail(&e);
+                    break;
+                }
+            }
+        }
+        self.finish(None)
+    }
+
     /// A checker sharing a catalogue.
     pub fn with_catalog(
         spec: &'s Spec,
@@ -1288,15 +1305,5 @@ pub fn check<I>(spec: &Spec, options: PnOptions, events: I) -> Result<Report, Se
 where
     I: IntoIterator<Item = Result<PnEvent, CaptureError>>,
 {
-    let mut c = PnChecker::new(spec, options)?;
-    for item in events {
-        match item {
-            Ok(ev) => c.push(&ev),
-            Err(e) => {
-                c.fail(&e);
-                break;
-            }
-        }
-    }
-    Ok(c.finish(None))
+    Ok(PnChecker::new(spec, options)?.run(events))
 }
