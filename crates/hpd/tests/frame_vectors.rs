@@ -39,7 +39,7 @@ fn manual_examples_decode_and_encode_byte_exact() {
                 v.id
             );
             assert!(
-                v.expect("response").is_none(),
+                v.expected("response").is_none(),
                 "{}: nothing answers an invalid frame",
                 v.id
             );
@@ -71,7 +71,7 @@ fn manual_examples_decode_and_encode_byte_exact() {
         };
         assert_eq!(Some(i64::from(lun)), int(v, "lun"), "{}: lun", v.id);
         assert_eq!(Some(i64::from(par)), int(v, "par"), "{}: par", v.id);
-        match v.expect("response").and_then(|x| x.as_str()) {
+        match v.expected("response").and_then(|x| x.as_str()) {
             Some(hex) => {
                 let response = parse_hex(hex).unwrap();
                 let answer =
@@ -90,7 +90,7 @@ fn manual_examples_decode_and_encode_byte_exact() {
                     v.id
                 );
                 if let (Some(want), Some(name), Message::Response { data, .. }) = (
-                    v.expect("value").and_then(toml::Value::as_integer),
+                    v.expected("value").and_then(toml::Value::as_integer),
                     v.input("param").and_then(|x| x.as_str()),
                     answer,
                 ) {

@@ -53,7 +53,7 @@ fn serial_vectors_run_against_the_model() {
         let msg = parse(&rules, &request).ok();
         let name = text(v, "param").or(text(v, "target"));
         let want = v
-            .expect("value")
+            .expected("value")
             .or(v.input("value"))
             .and_then(toml::Value::as_integer);
         // What the example reads is put into the drive first (Pr7 is a measurement).
@@ -69,7 +69,7 @@ fn serial_vectors_run_against_the_model() {
         // Let the time-out of a half-received frame pass too.
         d.advance(1_000 + 600_000);
         let sent = transmits(&drain(&mut d));
-        match v.expect("response").and_then(|x| x.as_str()) {
+        match v.expected("response").and_then(|x| x.as_str()) {
             Some(hex) => assert_eq!(sent, [parse_hex(hex).unwrap()], "{}", v.id),
             None => assert!(sent.is_empty(), "{}: the drive must stay silent", v.id),
         }

@@ -46,7 +46,7 @@ fn listings_encode_to_the_manual_bytes_and_back() {
             .parse_listing(&lines(v.input("listing").unwrap()))
             .unwrap_or_else(|e| panic!("{}: {e}", v.id));
         let bytes = codec.encode_program(&program).unwrap();
-        let want = parse_hex(v.expect("bytes").unwrap().as_str().unwrap()).unwrap();
+        let want = parse_hex(v.expected("bytes").unwrap().as_str().unwrap()).unwrap();
         assert_eq!(bytes, want, "{}", v.id);
         // Back from bytes: the same instructions, listed the same way.
         let mut at = 0;
@@ -123,7 +123,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
             }
             runtime.scan(&mut state, &mut mem, &program, inputs);
         }
-        for (name, want) in table(v.expect("params")) {
+        for (name, want) in table(v.expected("params")) {
             let slot = map.slot(ParamMap::parse_param(&name).unwrap()).unwrap();
             assert_eq!(
                 i64::from(mem.get_signed(slot.addr, slot.size)),
@@ -132,7 +132,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
                 v.id
             );
         }
-        for (name, want) in table(v.expect("bits")) {
+        for (name, want) in table(v.expected("bits")) {
             let (n, y) = ParamMap::parse_bit(&name).unwrap();
             assert_eq!(
                 mem.bit(map.bit(n, y).unwrap()),
@@ -141,7 +141,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
                 v.id
             );
         }
-        for (name, want) in table(v.expect("dwords")) {
+        for (name, want) in table(v.expected("dwords")) {
             let (lo, _) = name.split_once(':').unwrap();
             let slot = map.slot(ParamMap::parse_param(lo).unwrap()).unwrap();
             assert_eq!(
@@ -152,7 +152,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
             );
         }
         if let Some(ms) = v
-            .expect("elapsed_ms")
+            .expected("elapsed_ms")
             .and_then(|x| x.as_float().or(x.as_integer().map(|i| i as f64)))
         {
             let elapsed = scans as f64 * f64::from(runtime.scan_us()) / 1000.0;

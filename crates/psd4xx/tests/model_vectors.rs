@@ -207,7 +207,7 @@ fn run_sequence(v: &Vector) {
             assert!(!dropped, "{}", at(&s, "the drive stopped in between"));
         }
     }
-    if let Some(a) = v.expect("actual") {
+    if let Some(a) = v.expected("actual") {
         assert!(
             s.actual().abs_diff(int(a)) <= window as u64,
             "{id}: final actual"
@@ -256,19 +256,19 @@ fn every_record_vector_runs_on_the_model() {
             .record(req)
             .result
             .unwrap_or_else(|e| panic!("{id}: {e:?}"));
-        match (&answer, v.expect("data").and_then(toml::Value::as_str)) {
+        match (&answer, v.expected("data").and_then(toml::Value::as_str)) {
             (RecordAnswer::Data { bytes }, Some(hex)) => {
                 assert_eq!(bytes, &parse_hex(hex).unwrap(), "{id}: data")
             }
             (RecordAnswer::Written | RecordAnswer::Ignored, Some("")) => {}
             (RecordAnswer::Data { bytes }, None) => {
-                let text = v.expect("text").and_then(toml::Value::as_str).unwrap();
+                let text = v.expected("text").and_then(toml::Value::as_str).unwrap();
                 let until_nul: Vec<u8> = bytes.iter().copied().take_while(|b| *b != 0).collect();
                 assert_eq!(until_nul, text.as_bytes(), "{id}: text");
             }
             other => panic!("{id}: {other:?}"),
         }
-        state_matches(&s, id, v.expect("state"));
+        state_matches(&s, id, v.expected("state"));
     }
 }
 
@@ -294,9 +294,9 @@ fn every_pkw_vector_runs_on_the_model() {
         s.drive.handle_output(s.now, &out);
         s.drive.handle_output(s.now, &Output { pkw: req, ..out });
         let (_, input) = std::iter::from_fn(|| s.drive.poll_input()).last().unwrap();
-        let want = parse_hex(v.expect("bytes").and_then(toml::Value::as_str).unwrap()).unwrap();
+        let want = parse_hex(v.expected("bytes").and_then(toml::Value::as_str).unwrap()).unwrap();
         let got: PkwResponse = input.pkw;
         assert_eq!(got.to_bytes(rules.pkw()).unwrap(), want, "{id}: response");
-        state_matches(&s, id, v.expect("state"));
+        state_matches(&s, id, v.expected("state"));
     }
 }

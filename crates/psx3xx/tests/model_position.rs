@@ -25,7 +25,7 @@ fn int(v: &Vector, k: &str) -> Option<i64> {
 }
 
 fn want(v: &Vector, k: &str) -> Option<i64> {
-    v.expect(k).and_then(T::as_integer)
+    v.expected(k).and_then(T::as_integer)
 }
 
 fn eq(what: &str, got: i64, want: Option<i64>) -> Result<(), String> {
@@ -95,8 +95,8 @@ fn mapping(v: &Vector) -> Result<(), String> {
         s.f1(0x04, t as i32);
     }
     let testing_ume = int(v, "upper_mapping_end_before").is_some()
-        || v.expect("accepted").is_some()
-        || v.expect("upper_mapping_end").is_none();
+        || v.expected("accepted").is_some()
+        || v.expected("upper_mapping_end").is_none();
     if let Some(before) = int(v, "upper_mapping_end_before") {
         s.write_ok(128, before);
     } else if let (Some(ume), false) = (int(v, "upper_mapping_end"), testing_ume) {
@@ -109,7 +109,7 @@ fn mapping(v: &Vector) -> Result<(), String> {
         ("loop_length", 132),
     ] {
         if let Some(x) = int(v, k) {
-            if v.expect(k).is_none() || int(v, "denominator_before").is_some() {
+            if v.expected(k).is_none() || int(v, "denominator_before").is_some() {
                 s.write_ok(idx, x);
             }
         }
@@ -151,7 +151,7 @@ fn mapping(v: &Vector) -> Result<(), String> {
     }
     eq("ume_min", ume_min, want(v, "ume_min"))?;
     eq("ume_max", ume_max, want(v, "ume_max"))?;
-    if let (Some(a), Some(w)) = (accepted, v.expect("accepted").and_then(T::as_bool)) {
+    if let (Some(a), Some(w)) = (accepted, v.expected("accepted").and_then(T::as_bool)) {
         if a != w {
             return Err(format!("mapping end accepted = {a}, expected {w}"));
         }
@@ -227,7 +227,7 @@ fn legs(v: &Vector) -> Result<(), String> {
         }
     }
     let valid = !s.bit(12);
-    if let Some(w) = v.expect("valid_target").and_then(T::as_bool) {
+    if let Some(w) = v.expected("valid_target").and_then(T::as_bool) {
         if w != valid {
             return Err(format!(
                 "valid target = {valid}, status {:#06x}",
@@ -241,14 +241,14 @@ fn legs(v: &Vector) -> Result<(), String> {
         .into_iter()
         .filter(|w| *w != actual)
         .collect();
-    if let Some(want) = v.expect("legs").and_then(T::as_array) {
+    if let Some(want) = v.expected("legs").and_then(T::as_array) {
         let want: Vec<i64> = want.iter().filter_map(T::as_integer).collect();
         if want != legs {
             return Err(format!("legs {legs:?}, expected {want:?}"));
         }
     }
     for b in v
-        .expect("status_set")
+        .expected("status_set")
         .and_then(T::as_array)
         .into_iter()
         .flatten()

@@ -329,17 +329,17 @@ fn run_vector(v: &Vector) -> Result<(), String> {
         step(&mut s, st, &mut started).map_err(|e| format!("step {}: {e}", i + 1))?;
         s.run_ms(8);
     }
-    if let Some(run) = v.expect("final_run").and_then(T::as_str) {
+    if let Some(run) = v.expected("final_run").and_then(T::as_str) {
         if s.run() != run {
             return Err(format!("final run {} instead of {run}", s.run()));
         }
     }
-    if let Some(id) = int(v.expect("device_id")) {
+    if let Some(id) = int(v.expected("device_id")) {
         if s.drive.device_id().map(i64::from) != Some(id) {
             return Err(format!("device ID {:?}", s.drive.device_id()));
         }
     }
-    if let Some(state) = v.expect("final_state").and_then(T::as_table) {
+    if let Some(state) = v.expected("final_state").and_then(T::as_table) {
         for (k, val) in state {
             let got = s.read(k.parse().unwrap());
             if Some(got) != val.as_integer() {

@@ -106,7 +106,7 @@ fn process_image_vectors_decode_and_encode() {
                     .to_bytes(&rules, order)
                     .unwrap()
             };
-            check(Some(&bytes) == hex(v.expect("bytes")).as_ref(), "bytes");
+            check(Some(&bytes) == hex(v.expected("bytes")).as_ref(), "bytes");
         }
     }
 }
@@ -122,7 +122,7 @@ fn timestamp_vectors_have_their_meaning() {
         let m = Stamp(stamp).meaning(ts);
         let strict = v.result == VectorResult::Valid;
         let check = |key: &str, got: Option<toml::Value>| {
-            if let (Some(want), true) = (v.expect(key), strict) {
+            if let (Some(want), true) = (v.expected(key), strict) {
                 assert_eq!(got.as_ref(), Some(want), "{}: {key}", v.id);
             }
         };
@@ -184,7 +184,7 @@ fn isdu_vectors_are_answered_as_the_vector_says() {
         };
         let strict = v.result == VectorResult::Valid;
         let checked = rules.check_request(&request, model);
-        if let Some(code) = int(v.expect("error")) {
+        if let Some(code) = int(v.expected("error")) {
             let code = ErrorType(u16::try_from(code).unwrap());
             assert!(
                 rules.error_types().contains(code),
@@ -193,7 +193,7 @@ fn isdu_vectors_are_answered_as_the_vector_says() {
             );
             assert_eq!(ErrorType::parse(&code.to_bytes()), Ok(code), "{}", v.id);
             let alternatives: Vec<ErrorType> = v
-                .expect("error_alternatives")
+                .expected("error_alternatives")
                 .and_then(toml::Value::as_array)
                 .map(|a| {
                     a.iter()
@@ -225,13 +225,13 @@ fn isdu_vectors_are_answered_as_the_vector_says() {
         };
         match &request {
             Request::Read { .. } => {
-                let Some(data) = hex(v.expect("data")) else {
+                let Some(data) = hex(v.expected("data")) else {
                     continue;
                 };
                 let value = rules
                     .decode_value(&accepted.target, &data)
                     .unwrap_or_else(|e| panic!("{}: {e}", v.id));
-                if let Some(want) = int(v.expect("value")) {
+                if let Some(want) = int(v.expected("value")) {
                     assert_eq!(value, Value::Int(want), "{}: value", v.id);
                 }
                 assert_eq!(
@@ -263,7 +263,7 @@ fn isdu_vectors_are_answered_as_the_vector_says() {
                     "{}: re-encoding",
                     v.id
                 );
-                if let Some(name) = v.expect("command").and_then(toml::Value::as_str) {
+                if let Some(name) = v.expected("command").and_then(toml::Value::as_str) {
                     assert_eq!(
                         accepted.command.map(|c| c.name.as_str()),
                         Some(name),

@@ -120,7 +120,7 @@ impl Vector {
     }
 
     /// An expected value.
-    pub fn expect(&self, key: &str) -> Option<&toml::Value> {
+    pub fn expected(&self, key: &str) -> Option<&toml::Value> {
         self.expect.get(key)
     }
 }

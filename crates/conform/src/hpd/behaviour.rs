@@ -995,7 +995,7 @@ fn vectors(g: &mut Gen) {
                 .push(format!("vector {}: request is not hex", v.id));
             continue;
         };
-        let golden = match v.expect("response").and_then(|x| x.as_str()) {
+        let golden = match v.expected("response").and_then(|x| x.as_str()) {
             Some(h) => match parse_hex(h) {
                 Ok(b) => b,
                 Err(_) => {
@@ -1032,7 +1032,7 @@ fn vectors(g: &mut Gen) {
         let name = text_of(v, "param").or_else(|| text_of(v, "target"));
         let target = name.and_then(|n| Target::parse(g.family, n).ok());
         let want = v
-            .expect("value")
+            .expected("value")
             .or_else(|| v.input("value"))
             .and_then(toml::Value::as_integer);
         let mut compare = Compare::Exact;
@@ -1148,7 +1148,7 @@ fn plc_vectors(g: &mut Gen) {
                 .unwrap_or_default()
         };
         let expect = |key: &str| -> Vec<String> {
-            v.expect(key)
+            v.expected(key)
                 .and_then(|t| t.as_table())
                 .map(|t| t.keys().cloned().collect())
                 .unwrap_or_default()
