@@ -5,7 +5,7 @@
 use super::engine::{Fault, Trial};
 use super::replay::{Action, CyclicStep, FindingClass, Step};
 use crate::case::{CaseRun, Outcome, RequirementRef};
-use crate::cyclic::PeerError;
+use crate::cyclic::{Env, PeerError};
 use crate::link::Caps;
 use drivespec_spec::Family;
 
@@ -25,6 +25,15 @@ pub(super) const MAX_STEP_CYCLES: u32 = 60_000;
 /// Longest `advance` step (10 min).
 pub(super) const MAX_ADVANCE_US: u64 = 600_000_000;
 
+/// The kind of an injection: the first word of its `ENV` line (`jam`, `link`, …).
+pub(super) fn env_kind(env: &Env) -> String {
+    env.to_string()
+        .split(' ')
+        .next()
+        .unwrap_or_default()
+        .to_owned()
+}
+
 /// What kind of step a fuzz step is, for signatures: `own` names the family's steps, the
 /// steps every cyclic family has are named here.
 pub(super) fn kind(s: Option<&Step>, own: fn(&CyclicStep) -> Option<String>) -> String {
@@ -38,10 +47,7 @@ pub(super) fn kind(s: Option<&Step>, own: fn(&CyclicStep) -> Option<String>) -> 
         return name;
     }
     match c {
-        CyclicStep::Env(env) => {
-            let text = env.to_string();
-            format!("env-{}", text.split(' ').next().unwrap_or("?"))
-        }
+        CyclicStep::Env(env) => format!("env-{}", env_kind(env)),
         CyclicStep::Hold { .. } => "hold".to_owned(),
         CyclicStep::Until { .. } => "until".to_owned(),
         CyclicStep::Advance { .. } => "advance".to_owned(),

@@ -438,6 +438,26 @@ pub(crate) fn is_exchange(s: &Step) -> bool {
     )
 }
 
+/// Fails with the IDs a generator's templates name that `family` lacks.
+pub(crate) fn requirements_known<'i>(
+    family: &Family,
+    ids: impl Iterator<Item = &'i &'static str>,
+) -> Result<(), String> {
+    let mut missing: Vec<&str> = ids
+        .copied()
+        .filter(|id| family.requirement(id).is_none())
+        .collect();
+    missing.dedup();
+    if missing.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "fuzz templates name requirements the spec lacks: {}",
+            missing.join(", ")
+        ))
+    }
+}
+
 /// Every must/should requirement ID of `family`, in spec order ([`Target::requirement_ids`]).
 pub(crate) fn requirement_ids(family: &Family) -> Vec<(String, Level)> {
     family

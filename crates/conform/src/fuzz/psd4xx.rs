@@ -15,7 +15,7 @@
 
 use super::cyclic_target;
 use super::engine::{self, Target, Trial};
-use super::psd4xx_gen::{env_kind, PsdGen, ENV_KINDS};
+use super::psd4xx_gen::{PsdGen, ENV_KINDS};
 use super::replay::{Action, CyclicStep, Start, Step};
 use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
 use crate::cyclic::Peer;
@@ -48,7 +48,7 @@ impl<'a, 's> Psd4xxTarget<'a, 's> {
         let envs: Vec<String> = ENV_KINDS
             .iter()
             .filter(|e| session.takes(**e))
-            .map(env_kind)
+            .map(cyclic_target::env_kind)
             .collect();
         let gen = PsdGen::new(suite, envs).map_err(SetupError::Spec)?;
         Ok(Psd4xxTarget {

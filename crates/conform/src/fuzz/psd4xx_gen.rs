@@ -11,7 +11,8 @@
 //! environment changes interleave. Every value is drawn from the seeded [`Rng`] only; every
 //! requirement ID a step names is checked against the spec when the generator is built.
 
-use super::engine::{below, chance, pick};
+use super::cyclic_target::env_kind;
+use super::engine::{self, below, chance, pick};
 use super::replay::{Action, CyclicStep, Step};
 use crate::cyclic::Env;
 use crate::psd4xx::gen::{control, control_bit};
@@ -152,15 +153,6 @@ pub(crate) const ENV_KINDS: [Env; 8] = [
     Env::PowerCycle,
 ];
 
-/// The kind of an injection: its name on the `ENV` line.
-pub(crate) fn env_kind(env: &Env) -> String {
-    env.to_string()
-        .split(' ')
-        .next()
-        .unwrap_or_default()
-        .to_owned()
-}
-
 /// Requirement IDs of each template (checked against the spec in [`PsdGen::new`]).
 fn reqs(t: Template) -> &'static [&'static str] {
     match t {
@@ -251,25 +243,14 @@ fn class(t: Template) -> &'static str {
 
 impl PsdGen {
     /// The generator for the suite's model, sending only the injections of the kinds in
-    /// `envs` ([`env_kind`]); an error names what the spec lacks.
+    /// `envs` ([`super::cyclic_target::env_kind`]); an error names what the spec lacks.
     pub(crate) fn new(suite: &Psd4xxSuite<'_>, envs: Vec<String>) -> Result<PsdGen, String> {
         let family: &Family = suite.family();
         let rules = suite.reference().rules();
         let model = family
             .model(suite.model())
             .ok_or_else(|| format!("no model {}", suite.model()))?;
-        let mut missing: Vec<&str> = TEMPLATES
-            .iter()
-            .flat_map(|(t, _)| reqs(*t).iter().copied())
-            .filter(|id| family.requirement(id).is_none())
-            .collect();
-        missing.dedup();
-        if !missing.is_empty() {
-            return Err(format!(
-                "fuzz templates name requirements the spec lacks: {}",
-                missing.join(", ")
-            ));
-        }
+        engine::requirements_known(family, TEMPLATES.iter().flat_map(|(t, _)| reqs(*t)))?;
         let params: Vec<Param> = family
             .parameters
             .iter()

@@ -51,13 +51,7 @@ impl<'a, 's> Psx3xxTarget<'a, 's> {
         let envs: Vec<String> = ENV_KINDS
             .iter()
             .filter(|e| session.takes(**e))
-            .map(|e| {
-                e.to_string()
-                    .split(' ')
-                    .next()
-                    .unwrap_or_default()
-                    .to_owned()
-            })
+            .map(cyclic_target::env_kind)
             .collect();
         let gen = PsxGen::new(suite, envs).map_err(SetupError::Spec)?;
         let rules = suite.reference().rules();

@@ -15,7 +15,7 @@
 //! [`Rng`] only; every requirement ID a step names is checked against the spec when the
 //! generator is built.
 
-use super::engine::{below, chance, pick};
+use super::engine::{self, below, chance, pick};
 use super::replay::{Action, CyclicStep, Step};
 use crate::cyclic::Env;
 use crate::psx3xx::Psx3xxSuite;
@@ -294,18 +294,7 @@ impl<'s> PsxGen<'s> {
         let model = family
             .model(suite.model())
             .ok_or_else(|| format!("no model {}", suite.model()))?;
-        let mut missing: Vec<&str> = TEMPLATES
-            .iter()
-            .flat_map(|(t, _)| reqs(*t).iter().copied())
-            .filter(|id| family.requirement(id).is_none())
-            .collect();
-        missing.dedup();
-        if !missing.is_empty() {
-            return Err(format!(
-                "fuzz templates name requirements the spec lacks: {}",
-                missing.join(", ")
-            ));
-        }
+        engine::requirements_known(family, TEMPLATES.iter().flat_map(|(t, _)| reqs(*t)))?;
         let entries: Vec<Entry> = family
             .parameters
             .iter()
