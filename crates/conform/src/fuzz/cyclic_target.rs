@@ -11,7 +11,7 @@ use drivespec_spec::Family;
 
 /// Every run starts with `RESET` on the device and a fresh reference, on any transport; times
 /// are virtual (carried in the requests).
-pub(super) const CAPS: Caps = Caps {
+pub(crate) const CAPS: Caps = Caps {
     reset: true,
     power_cycle: true,
     virtual_time: true,
@@ -20,13 +20,13 @@ pub(super) const CAPS: Caps = Caps {
 
 /// Most cycles one `hold` or `until` step runs (10 min of bus time at 10 ms): a replay file
 /// cannot make a run endless.
-pub(super) const MAX_STEP_CYCLES: u32 = 60_000;
+pub(crate) const MAX_STEP_CYCLES: u32 = 60_000;
 
 /// Longest `advance` step (10 min).
-pub(super) const MAX_ADVANCE_US: u64 = 600_000_000;
+pub(crate) const MAX_ADVANCE_US: u64 = 600_000_000;
 
 /// The kind of an injection: the first word of its `ENV` line (`jam`, `link`, …).
-pub(super) fn env_kind(env: &Env) -> String {
+pub(crate) fn env_kind(env: &Env) -> String {
     env.to_string()
         .split(' ')
         .next()
@@ -36,7 +36,7 @@ pub(super) fn env_kind(env: &Env) -> String {
 
 /// What kind of step a fuzz step is, for signatures: `own` names the family's steps, the
 /// steps every cyclic family has are named here.
-pub(super) fn kind(s: Option<&Step>, own: fn(&CyclicStep) -> Option<String>) -> String {
+pub(crate) fn kind(s: Option<&Step>, own: fn(&CyclicStep) -> Option<String>) -> String {
     let Some(action) = s.map(|s| &s.action) else {
         return "start".to_owned();
     };
@@ -58,7 +58,7 @@ pub(super) fn kind(s: Option<&Step>, own: fn(&CyclicStep) -> Option<String>) -> 
 /// The trial of a case run: none when it passed; otherwise a crash when the transport failed,
 /// a hang when the device did not reply in time, a mismatch otherwise (`differs` names the
 /// fields of the failing step's answer that differ), with the failing step's requirements.
-pub(super) fn trial(
+pub(crate) fn trial(
     mut run: CaseRun,
     peer_error: Option<PeerError>,
     steps: &[Step],

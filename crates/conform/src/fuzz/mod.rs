@@ -19,17 +19,11 @@
 //! both over the cyclic-exchange protocol; each implements the crate-internal `Target`
 //! (`engine.rs`) with its generator and the family's conformance session.
 
-mod cyclic_target;
+pub(crate) mod cyclic_target;
 mod ddmin;
-mod engine;
-mod hpd;
-mod hpd_gen;
+pub(crate) mod engine;
 mod output;
-mod psd4xx;
-mod psd4xx_gen;
-mod psx3xx;
-mod psx3xx_gen;
-mod replay;
+pub(crate) mod replay;
 mod stats;
 
 pub use output::{json as report_json, Finding};
@@ -221,7 +215,7 @@ fn with_target<R>(
                 }
                 None => suite.link(&opts.dut)?,
             };
-            let mut target = hpd::HpdTarget::new(&suite, link)?;
+            let mut target = crate::hpd::fuzz::HpdTarget::new(&suite, link)?;
             f(&mut target)
         }
         FamilyId::Psd4xx => {
@@ -231,7 +225,7 @@ fn with_target<R>(
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
                 None => suite.peer(&opts.dut)?,
             };
-            let mut target = psd4xx::Psd4xxTarget::new(&suite, peer)?;
+            let mut target = crate::psd4xx::fuzz::Psd4xxTarget::new(&suite, peer)?;
             f(&mut target)
         }
         FamilyId::Psx3xx => {
@@ -241,7 +235,7 @@ fn with_target<R>(
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
                 None => suite.peer(&opts.dut)?,
             };
-            let mut target = psx3xx::Psx3xxTarget::new(&suite, peer)?;
+            let mut target = crate::psx3xx::fuzz::Psx3xxTarget::new(&suite, peer)?;
             f(&mut target)
         }
     }

@@ -2,7 +2,7 @@
 //! upload and read-back, command bits with their preconditions, every Pr26 code with its
 //! time-out, and the spec's golden vectors (manual 3.4, 3.8.1, 4, 4.1).
 
-use super::gen::{bit_value, sign_for, CaseB, Gen};
+use super::cases::{bit_value, sign_for, CaseB, Gen};
 use super::names;
 use super::step::{Action, Compare, Step};
 use crate::case::Role;

@@ -1,7 +1,7 @@
 //! `hpd/frame/...`: framing and every message type (manual 4.1), stuffing, corrupt frames,
 //! foreign addresses and time-outs.
 
-use super::gen::{CaseB, Gen};
+use super::cases::{CaseB, Gen};
 use super::names;
 use super::step::{Action, Compare};
 use crate::case::Role;
@@ -61,7 +61,13 @@ fn still_answers(g: &mut Gen, cb: &mut CaseB, slot: Slot) {
     );
 }
 
-fn message_types(g: &mut Gen, ranged: Slot, scratch: Slot, flag: &super::gen::BitRef, value: i64) {
+fn message_types(
+    g: &mut Gen,
+    ranged: Slot,
+    scratch: Slot,
+    flag: &super::cases::BitRef,
+    value: i64,
+) {
     let own = g.addr;
     let mut cb = CaseB::new(
         "hpd/frame/read-parameter",

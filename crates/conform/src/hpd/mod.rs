@@ -16,8 +16,9 @@
 //! | `vector` | the spec's `hpd-frame` vectors, at their drive address |
 
 mod behaviour;
+pub(crate) mod cases;
 pub(crate) mod frame;
-pub(crate) mod gen;
+pub(crate) mod fuzz;
 pub(crate) mod names;
 mod params;
 mod session;
@@ -100,7 +101,7 @@ impl<'s> HpdSuite<'s> {
             None => DriveConfig::commissioned(settings.address),
         };
         let baseline = Drive::new(spec, config).map_err(|e| SetupError::Spec(e.to_string()))?;
-        let mut g = gen::Gen::new(
+        let mut g = cases::Gen::new(
             spec,
             baseline.clone(),
             model,

@@ -3,7 +3,7 @@
 //! it), read-only parameters refusing writes, byte/word/double-word accesses, and every bit
 //! set and cleared with a bit change on its byte (manual 3.3, 3.6, 4.1, 4.2).
 
-use super::gen::{bit_value, sign_for, BitRef, CaseB, Gen};
+use super::cases::{bit_value, sign_for, BitRef, CaseB, Gen};
 use super::names;
 use super::step::Compare;
 use crate::case::Role;

@@ -17,7 +17,8 @@
 //! block and status word exactly; position and speed within the case's declared tolerance,
 //! and a time tolerance in cycles for the motion cases.
 
-pub(crate) mod gen;
+pub(crate) mod cases;
+pub(crate) mod fuzz;
 mod session;
 
 pub use session::Psd4xxSession;
@@ -27,9 +28,9 @@ use crate::cyclic::{LinkPeer, LocalPeer, Peer, Server};
 use crate::dut::Dut;
 use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, Settings, SetupError, Suite};
+use cases::PsdCase;
 use drivespec_psd4xx::model::{Drive, DriveConfig};
 use drivespec_spec::{Family, FamilyId, Spec};
-use gen::PsdCase;
 
 /// The device model `--model` selects when none is given: an ungeared PSD 401 (the model the
 /// spec's vectors assume).
@@ -61,7 +62,7 @@ impl<'s> Psd4xxSuite<'s> {
         })?;
         let baseline = Drive::new(spec, DriveConfig::new(&model.id))
             .map_err(|e| SetupError::Spec(e.to_string()))?;
-        let (infos, cases) = gen::generate(family, model, &baseline).map_err(SetupError::Spec)?;
+        let (infos, cases) = cases::generate(family, model, &baseline).map_err(SetupError::Spec)?;
         Ok(Psd4xxSuite {
             family,
             model: model.id.clone(),

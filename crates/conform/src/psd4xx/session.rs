@@ -1,7 +1,7 @@
 //! Running PSD4xx cases: the device under test and a fresh reference drive get the same
 //! requests; every cycle's input image and every record and injection reply is compared.
 
-use super::gen::{status_bit, Action, PsdCase, Tolerance, PKW_MAX_CYCLES};
+use super::cases::{status_bit, Action, PsdCase, Tolerance, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::cyclic::device::Device;

@@ -20,7 +20,8 @@
 //! and speed within the case's declared tolerance; every ISDU and injection reply exactly,
 //! except the live speed and position read by ISDU, which get the same tolerance.
 
-pub(crate) mod gen;
+pub(crate) mod cases;
+pub(crate) mod fuzz;
 mod session;
 
 pub use session::Psx3xxSession;
@@ -30,9 +31,9 @@ use crate::cyclic::{LinkPeer, LocalPeer, Peer, Server};
 use crate::dut::Dut;
 use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, Settings, SetupError, Suite};
+use cases::PsxCase;
 use drivespec_psx3xx::model::{Drive, DriveConfig};
 use drivespec_spec::{Family, FamilyId, Spec};
-use gen::PsxCase;
 
 /// The device model `--model` selects when none is given: the PSE 312-8 the spec's vectors
 /// assume (`spec/psx3xx/vectors/isdu.toml`).
@@ -77,7 +78,7 @@ impl<'s> Psx3xxSuite<'s> {
         let baseline = Drive::new(spec, config).map_err(|e| SetupError::Spec(e.to_string()))?;
         let cycle_us = min_cycle_us(&baseline)?;
         let (infos, cases) =
-            gen::generate(family, model, &baseline, cycle_us).map_err(SetupError::Spec)?;
+            cases::generate(family, model, &baseline, cycle_us).map_err(SetupError::Spec)?;
         Ok(Psx3xxSuite {
             family,
             model: model.id.clone(),

@@ -1,7 +1,7 @@
 //! Running PSx3xx cases: the device under test and a fresh reference drive get the same
 //! requests; every cycle's input image and every ISDU and injection reply is compared.
 
-use super::gen::{Action, PsxCase, Tolerance};
+use super::cases::{Action, PsxCase, Tolerance};
 use super::Psx3xxSuite;
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::cyclic::device::Device;

@@ -1,4 +1,4 @@
-//! The PSD4xx fuzz target: sequences from [`super::psd4xx_gen`], run as a case through the
+//! The PSD4xx fuzz target: sequences from [`sequences`], run as a case through the
 //! conformance session ([`Psd4xxSession`]) over the cyclic-exchange protocol, so every cycle's
 //! input image and every record and injection reply is judged exactly as `drivespec conform`
 //! judges it: the reference drive fed the same requests, PKW and status exact, position and
@@ -13,14 +13,15 @@
 //! closed), a hang when the device sent no reply within the protocol's time-out (2 s), and a
 //! mismatch otherwise; the signature names the step kind and the fields that differ.
 
-use super::cyclic_target;
-use super::engine::{self, Target, Trial};
-use super::psd4xx_gen::{PsdGen, ENV_KINDS};
-use super::replay::{Action, CyclicStep, Start, Step};
+mod sequences;
+
 use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
 use crate::cyclic::Peer;
+use crate::fuzz::cyclic_target;
+use crate::fuzz::engine::{self, Target, Trial};
+use crate::fuzz::replay::{Action, CyclicStep, Start, Step};
 use crate::link::{Caps, LinkError};
-use crate::psd4xx::gen::{self, PsdCase, StepDef, EXCHANGE, MOTION};
+use crate::psd4xx::cases::{self as cases, PsdCase, StepDef, EXCHANGE, MOTION};
 use crate::psd4xx::{Psd4xxSession, Psd4xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
@@ -28,6 +29,7 @@ use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, PkwRequest};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{FamilyId, Level};
+use sequences::{PsdGen, ENV_KINDS};
 
 /// The PSD4xx target on one device under test.
 pub(crate) struct Psd4xxTarget<'a, 's> {
@@ -164,11 +166,11 @@ fn own_kind(c: &CyclicStep) -> Option<String> {
 fn to_case_step(s: &Step) -> StepDef {
     let action = match &s.action {
         Action::Cyclic(c) => match c {
-            CyclicStep::Process { control, target } => gen::Action::Process {
+            CyclicStep::Process { control, target } => cases::Action::Process {
                 control: *control,
                 target: *target,
             },
-            CyclicStep::Offset { control, offset } => gen::Action::Offset {
+            CyclicStep::Offset { control, offset } => cases::Action::Offset {
                 control: *control,
                 offset: *offset,
             },
@@ -178,7 +180,7 @@ fn to_case_step(s: &Step) -> StepDef {
                 pnu,
                 ind,
                 pwe,
-            } => gen::Action::Pkw(PkwRequest {
+            } => cases::Action::Pkw(PkwRequest {
                 ak: (*ak).into(),
                 spm: *spm,
                 pnu: *pnu,
@@ -186,28 +188,30 @@ fn to_case_step(s: &Step) -> StepDef {
                 pwe: *pwe,
             }),
             CyclicStep::Hold { cycles } => {
-                gen::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
+                cases::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
             }
-            CyclicStep::Until { running, max } => gen::Action::Until {
+            CyclicStep::Until { running, max } => cases::Action::Until {
                 running: *running,
                 max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
             },
             CyclicStep::RecordRead { index } => {
-                gen::Action::Record(RecordRequest::Read { index: *index })
+                cases::Action::Record(RecordRequest::Read { index: *index })
             }
-            CyclicStep::RecordWrite { index, data } => gen::Action::Record(RecordRequest::Write {
-                index: *index,
-                data: data.clone(),
-            }),
-            CyclicStep::Env(env) => gen::Action::Env(*env),
+            CyclicStep::RecordWrite { index, data } => {
+                cases::Action::Record(RecordRequest::Write {
+                    index: *index,
+                    data: data.clone(),
+                })
+            }
+            CyclicStep::Env(env) => cases::Action::Env(*env),
             CyclicStep::Advance { us } => {
-                gen::Action::Advance((*us).min(cyclic_target::MAX_ADVANCE_US))
+                cases::Action::Advance((*us).min(cyclic_target::MAX_ADVANCE_US))
             }
             CyclicStep::ProcessData { .. }
             | CyclicStep::IsduRead { .. }
-            | CyclicStep::IsduWrite { .. } => gen::Action::Hold(1),
+            | CyclicStep::IsduWrite { .. } => cases::Action::Hold(1),
         },
-        _ => gen::Action::Hold(1),
+        _ => cases::Action::Hold(1),
     };
     StepDef {
         role: Role::Check,

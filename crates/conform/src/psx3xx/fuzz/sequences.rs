@@ -15,9 +15,9 @@
 //! [`Rng`] only; every requirement ID a step names is checked against the spec when the
 //! generator is built.
 
-use super::engine::{self, below, chance, pick};
-use super::replay::{Action, CyclicStep, Step};
 use crate::cyclic::Env;
+use crate::fuzz::engine::{self, below, chance, pick};
+use crate::fuzz::replay::{Action, CyclicStep, Step};
 use crate::psx3xx::Psx3xxSuite;
 use crate::rng::Rng;
 use drivespec_psd4xx::model::LinkEvent;

@@ -11,11 +11,11 @@
 //! environment changes interleave. Every value is drawn from the seeded [`Rng`] only; every
 //! requirement ID a step names is checked against the spec when the generator is built.
 
-use super::cyclic_target::env_kind;
-use super::engine::{self, below, chance, pick};
-use super::replay::{Action, CyclicStep, Step};
 use crate::cyclic::Env;
-use crate::psd4xx::gen::{control, control_bit};
+use crate::fuzz::cyclic_target::env_kind;
+use crate::fuzz::engine::{self, below, chance, pick};
+use crate::fuzz::replay::{Action, CyclicStep, Step};
+use crate::psd4xx::cases::{control, control_bit};
 use crate::psd4xx::Psd4xxSuite;
 use crate::rng::Rng;
 use drivespec_psd4xx::model::LinkEvent;
@@ -243,7 +243,7 @@ fn class(t: Template) -> &'static str {
 
 impl PsdGen {
     /// The generator for the suite's model, sending only the injections of the kinds in
-    /// `envs` ([`super::cyclic_target::env_kind`]); an error names what the spec lacks.
+    /// `envs` ([`crate::fuzz::cyclic_target::env_kind`]); an error names what the spec lacks.
     pub(crate) fn new(suite: &Psd4xxSuite<'_>, envs: Vec<String>) -> Result<PsdGen, String> {
         let family: &Family = suite.family();
         let rules = suite.reference().rules();

@@ -7,11 +7,11 @@
 //! The generator draws only from the [`Rng`] it is given; nothing here reads a clock or the
 //! device. Nothing panics: a message that cannot be built is skipped.
 
-use super::engine::{below, chance, pick};
-use super::replay::{Action, Compare, Step};
 use crate::case::Role;
+use crate::fuzz::engine::{below, chance, pick};
+use crate::fuzz::replay::{Action, Compare, Step};
+use crate::hpd::cases::{BitRef, CaseB, Gen};
 use crate::hpd::frame::frame;
-use crate::hpd::gen::{BitRef, CaseB, Gen};
 use crate::hpd::names;
 use crate::hpd::step::{Action as HAction, Compare as HCompare, Step as HStep};
 use crate::hpd::HpdSuite;
@@ -829,7 +829,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             return;
         };
         let base = self.g.base(s);
-        let v = crate::hpd::gen::sign_for(s, base ^ (1 + u32::from(rng.byte())), self.g.family);
+        let v = crate::hpd::cases::sign_for(s, base ^ (1 + u32::from(rng.byte())), self.g.family);
         self.write_slot(out, "read-only-write", s, v, &p.id);
         let linked = self.linked(p);
         self.tag(out, linked.iter().map(String::as_str));

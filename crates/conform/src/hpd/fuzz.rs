@@ -1,4 +1,4 @@
-//! The HPD fuzz target: sequences from [`super::hpd_gen`], run through the conformance
+//! The HPD fuzz target: sequences from [`sequences`], run through the conformance
 //! session ([`HpdSession`]) so every answer is judged exactly as `drivespec conform` judges it
 //! (the reference drive fed the same bytes at the same times, manual chapter 4).
 //!
@@ -6,10 +6,11 @@
 //! closed), a hang when the device was silent where the reference answers and stays silent
 //! to a liveness probe (a read of Pr33), and a mismatch otherwise.
 
-use super::engine::{self, Fault, Target, Trial};
-use super::hpd_gen::HpdGen;
-use super::replay::{Action, Compare, FindingClass, Start, Step};
+mod sequences;
+
 use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use crate::fuzz::engine::{self, Fault, Target, Trial};
+use crate::fuzz::replay::{Action, Compare, FindingClass, Start, Step};
 use crate::hpd::step::{Action as HAction, Compare as HCompare, HpdCase, Step as HStep};
 use crate::hpd::{HpdSession, HpdSuite};
 use crate::link::{Caps, Link, LinkError, Recovered};
@@ -18,6 +19,7 @@ use crate::suite::SetupError;
 use drivespec_hpd::memory::Slot;
 use drivespec_hpd::{FrameRules, Message};
 use drivespec_spec::{Family, FamilyId, Level};
+use sequences::HpdGen;
 
 /// The HPD target on one device under test.
 pub(crate) struct HpdTarget<'a, 's> {

@@ -1,4 +1,4 @@
-//! The PSx3xx fuzz target: sequences from [`super::psx3xx_gen`], run as a case through the
+//! The PSx3xx fuzz target: sequences from [`sequences`], run as a case through the
 //! conformance session ([`Psx3xxSession`]) over the cyclic-exchange protocol, so every cycle's
 //! input image and every ISDU and injection reply is judged exactly as `drivespec conform`
 //! judges it: the reference drive fed the same requests, ISDU replies and the status word
@@ -13,14 +13,15 @@
 //! closed), a hang when the device sent no reply within the protocol's time-out (2 s), and a
 //! mismatch otherwise; the signature names the step kind and what differs.
 
-use super::cyclic_target;
-use super::engine::{self, Target, Trial};
-use super::psx3xx_gen::{PsxGen, ENV_KINDS};
-use super::replay::{Action, CyclicStep, Start, Step};
+mod sequences;
+
 use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
 use crate::cyclic::Peer;
+use crate::fuzz::cyclic_target;
+use crate::fuzz::engine::{self, Target, Trial};
+use crate::fuzz::replay::{Action, CyclicStep, Start, Step};
 use crate::link::{Caps, LinkError};
-use crate::psx3xx::gen::{self, PsxCase, StepDef, EXACT, MOTION};
+use crate::psx3xx::cases::{self as cases, PsxCase, StepDef, EXACT, MOTION};
 use crate::psx3xx::{Psx3xxSession, Psx3xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
@@ -28,6 +29,7 @@ use drivespec_psx3xx::isdu::Request as IsduRequest;
 use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{FamilyId, Level};
+use sequences::{PsxGen, ENV_KINDS};
 
 /// The PSx3xx target on one device under test.
 pub(crate) struct Psx3xxTarget<'a, 's> {
@@ -195,8 +197,8 @@ fn to_case_step(s: &Step) -> StepDef {
                 target,
                 speed,
                 stamp,
-            } => gen::Action::Out(output(*format, *control, *target, *speed, *stamp)),
-            CyclicStep::IsduRead { index, subindex } => gen::Action::Isdu(IsduRequest::Read {
+            } => cases::Action::Out(output(*format, *control, *target, *speed, *stamp)),
+            CyclicStep::IsduRead { index, subindex } => cases::Action::Isdu(IsduRequest::Read {
                 index: *index,
                 subindex: *subindex,
             }),
@@ -204,29 +206,29 @@ fn to_case_step(s: &Step) -> StepDef {
                 index,
                 subindex,
                 data,
-            } => gen::Action::Isdu(IsduRequest::Write {
+            } => cases::Action::Isdu(IsduRequest::Write {
                 index: *index,
                 subindex: *subindex,
                 data: data.clone(),
             }),
             CyclicStep::Hold { cycles } => {
-                gen::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
+                cases::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
             }
-            CyclicStep::Until { running, max } => gen::Action::Until {
+            CyclicStep::Until { running, max } => cases::Action::Until {
                 running: *running,
                 max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
             },
-            CyclicStep::Env(env) => gen::Action::Env(*env),
+            CyclicStep::Env(env) => cases::Action::Env(*env),
             CyclicStep::Advance { us } => {
-                gen::Action::Silence((*us).min(cyclic_target::MAX_ADVANCE_US))
+                cases::Action::Silence((*us).min(cyclic_target::MAX_ADVANCE_US))
             }
             CyclicStep::Process { .. }
             | CyclicStep::Offset { .. }
             | CyclicStep::Pkw { .. }
             | CyclicStep::RecordRead { .. }
-            | CyclicStep::RecordWrite { .. } => gen::Action::Hold(1),
+            | CyclicStep::RecordWrite { .. } => cases::Action::Hold(1),
         },
-        _ => gen::Action::Hold(1),
+        _ => cases::Action::Hold(1),
     };
     StepDef {
         role: Role::Check,
