@@ -1,4 +1,4 @@
-//! Trace checkers (issue 7): spec violations in recorded traffic of the three drive families,
+//! Trace checkers: spec violations in recorded traffic of the three drive families,
 //! each with the requirement ID and text, where it happened (frame number or byte offset,
 //! time) and the evidence.
 //!

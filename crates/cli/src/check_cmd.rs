@@ -1,4 +1,4 @@
-//! `drivespec check`: recorded traffic against the spec (issue 7). Parsing, progress and
+//! `drivespec check`: recorded traffic against the spec. Parsing, progress and
 //! printing only; the work is in `drivespec_check`.
 
 use crate::{Context, Format, Outcome};

@@ -1,4 +1,4 @@
-//! Benchmarks of the conformance run (issue 6, section 7), printed as rows for the README's
+//! Benchmarks of the conformance run, printed as rows for the README's
 //! performance table:
 //!
 //! 1. the full HPD suite against the built-in model (`--dut sim`, virtual time): wall time,

@@ -1,7 +1,8 @@
 //! What every family's cases and results look like to the runner and the reports: a case's
 //! identity and coverage, its outcome, and the evidence of each step.
 //!
-//! These types are the JSON report's vocabulary (`REPORTS.md`): fields are only ever added.
+//! These types are the JSON report's vocabulary (schema in `crates/conform/README.md`, "JSON
+//! report"): fields are only ever added.
 
 use drivespec_spec::{Family, FamilyId, Level};
 use serde::Serialize;

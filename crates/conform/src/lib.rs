@@ -8,7 +8,8 @@
 //! - [`link`]: the transports (`sim`, `serial`, `tcp`, `exec`) behind [`link::Link`].
 //! - [`runner`]: selection, expectations, progress, reports; [`runner::run`] is what the CLI
 //!   calls.
-//! - [`report`]: the report model and its renderings (schema in `REPORTS.md`).
+//! - [`report`]: the report model and its renderings (schema in the crate
+//!   README, "JSON report").
 //!
 //! Nothing here panics on any input or device behaviour; every wait is bounded by a deadline.
 #![forbid(unsafe_code)]

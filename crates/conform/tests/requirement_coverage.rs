@@ -1,4 +1,4 @@
-//! Requirement coverage gate (issue 5): every `must` requirement of a gated family is named by
+//! Requirement coverage gate: every `must` requirement of a gated family is named by
 //! an implementation or a test somewhere in the workspace's Rust sources, or has a written
 //! reason in `tests/uncovered-<family>.toml` (rustls `bogo/config.json.in` style: no
 //! exclusion without a reason).

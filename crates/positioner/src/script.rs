@@ -1,5 +1,5 @@
 //! The `sim-run` script: a small line format of timed commands, environment changes and
-//! expectations that a family's reference model runs on virtual time (issue 5 "Done when").
+//! expectations that a family's reference model runs on virtual time.
 //!
 //! This module holds what every family shares: the line grammar, the times, the environment
 //! changes of [`mod@crate::env`], the expectations and the resulting [`Trace`]. A family adds its
@@ -31,7 +31,7 @@ use crate::machine::{CoreEvent, Micros};
 use serde::Serialize;
 use std::fmt;
 
-/// Why a script line cannot be read (issue 5 sim-run).
+/// Why a script line cannot be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum LineError {
@@ -93,7 +93,7 @@ pub enum LineError {
     },
 }
 
-/// A script error with the line it is on (issue 5 sim-run).
+/// A script error with the line it is on.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("line {line}: {error} (in {text:?})")]
 pub struct ScriptError {
@@ -106,7 +106,7 @@ pub struct ScriptError {
 }
 
 /// A family's commands in a script: parses the words after the time that are not `env`,
-/// `expect` or `end` (issue 5 sim-run).
+/// `expect` or `end`.
 pub trait Dialect {
     /// A parsed family command.
     type Command;
@@ -116,7 +116,7 @@ pub trait Dialect {
     fn verbs(&self) -> &'static str;
 }
 
-/// What an expectation looks at (issue 5 sim-run).
+/// What an expectation looks at.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(tag = "what", rename_all = "kebab-case")]
 pub enum Probe {
@@ -133,7 +133,7 @@ pub enum Probe {
     },
 }
 
-/// An expectation: a probe and the inclusive range its value must lie in (issue 5 sim-run).
+/// An expectation: a probe and the inclusive range its value must lie in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Expect {
     /// What is looked at.
@@ -144,7 +144,7 @@ pub struct Expect {
     pub high: i64,
 }
 
-/// What the drive shows at one moment, for expectations and samples (issue 5 sim-run).
+/// What the drive shows at one moment, for expectations and samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Observation {
     /// Actual position, user increments.
@@ -156,7 +156,7 @@ pub struct Observation {
 }
 
 impl Expect {
-    /// The value the probe reads in `o` (issue 5 sim-run).
+    /// The value the probe reads in `o`.
     pub fn value(&self, o: &Observation) -> i64 {
         match self.probe {
             Probe::Position => o.position,
@@ -166,13 +166,13 @@ impl Expect {
         }
     }
 
-    /// Whether `o` meets the expectation (issue 5 sim-run).
+    /// Whether `o` meets the expectation.
     pub fn holds(&self, o: &Observation) -> bool {
         (self.low..=self.high).contains(&self.value(o))
     }
 }
 
-/// One script action (issue 5 sim-run).
+/// One script action.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Action<C> {
     /// An environment change.
@@ -185,7 +185,7 @@ pub enum Action<C> {
     Device(C),
 }
 
-/// One script line (issue 5 sim-run).
+/// One script line.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step<C> {
     /// Line number, 1-based.
@@ -198,7 +198,7 @@ pub struct Step<C> {
     pub action: Action<C>,
 }
 
-/// A parsed script: steps in time order (issue 5 sim-run).
+/// A parsed script: steps in time order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Script<C> {
     /// The steps, in file order (times never decrease).
@@ -206,7 +206,7 @@ pub struct Script<C> {
 }
 
 impl<C> Script<C> {
-    /// Parses a script with a family's dialect (issue 5 sim-run).
+    /// Parses a script with a family's dialect.
     pub fn parse<D: Dialect<Command = C>>(
         text: &str,
         dialect: &D,
@@ -242,7 +242,7 @@ impl<C> Script<C> {
         Ok(Script { steps })
     }
 
-    /// The time of the `end` step, if there is one (issue 5 sim-run).
+    /// The time of the `end` step, if there is one.
     pub fn end(&self) -> Option<Micros> {
         self.steps
             .iter()
@@ -250,7 +250,7 @@ impl<C> Script<C> {
             .map(|s| s.at)
     }
 
-    /// The time of the last step, 0 for an empty script (issue 5 sim-run).
+    /// The time of the last step, 0 for an empty script.
     pub fn last(&self) -> Micros {
         self.steps.last().map_or(0, |s| s.at)
     }
@@ -305,7 +305,7 @@ fn parse_action<D: Dialect>(command: &str, dialect: &D) -> Result<Action<D::Comm
     }
 }
 
-/// The first word and the trimmed rest (issue 5 sim-run).
+/// The first word and the trimmed rest.
 pub fn split_word(text: &str) -> (&str, &str) {
     let t = text.trim();
     match t.split_once(char::is_whitespace) {
@@ -314,7 +314,7 @@ pub fn split_word(text: &str) -> (&str, &str) {
     }
 }
 
-/// Fails when `rest` is not empty (issue 5 sim-run).
+/// Fails when `rest` is not empty.
 pub fn no_more(rest: &str) -> Result<(), LineError> {
     if rest.trim().is_empty() {
         Ok(())
@@ -325,7 +325,7 @@ pub fn no_more(rest: &str) -> Result<(), LineError> {
     }
 }
 
-/// An integer: decimal with an optional sign, or `0x` hex, `_` allowed (issue 5 sim-run).
+/// An integer: decimal with an optional sign, or `0x` hex, `_` allowed.
 pub fn parse_int(what: &'static str, text: &str) -> Result<i64, LineError> {
     let bad = || LineError::BadNumber {
         what,
@@ -349,7 +349,7 @@ pub fn parse_int(what: &'static str, text: &str) -> Result<i64, LineError> {
     Ok(if neg { -magnitude } else { magnitude })
 }
 
-/// An integer that fits `T` (issue 5 sim-run).
+/// An integer that fits `T`.
 pub fn parse_in<T: TryFrom<i64>>(what: &'static str, text: &str) -> Result<T, LineError> {
     let n = parse_int(what, text)?;
     T::try_from(n).map_err(|_| LineError::BadNumber {
@@ -498,7 +498,7 @@ impl fmt::Display for Expect {
 
 // ---------------------------------------------------------------------- traces
 
-/// A status bit's number and spec name, for the trace legend (issue 5 sim-run).
+/// A status bit's number and spec name, for the trace legend.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct BitName {
     /// Bit number.
@@ -507,7 +507,7 @@ pub struct BitName {
     pub name: String,
 }
 
-/// What one trace entry records (issue 5 sim-run).
+/// What one trace entry records.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum What<E> {
@@ -559,7 +559,7 @@ pub enum What<E> {
     TailLimit,
 }
 
-/// One trace entry (issue 5 sim-run).
+/// One trace entry.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Entry<E> {
     /// Virtual time, µs.
@@ -569,7 +569,7 @@ pub struct Entry<E> {
     pub what: What<E>,
 }
 
-/// The result of a script run (issue 5 sim-run).
+/// The result of a script run.
 ///
 /// JSON: `{"family", "model", "every_ms", "bits": [{"bit", "name"}], "entries": [{"t_us",
 /// "kind": "step"|"sample"|"answer"|"event"|"check"|"tail-limit", …}], "passed", "failed"}`.
@@ -592,8 +592,7 @@ pub struct Trace<E> {
 }
 
 impl<E: fmt::Display> Trace<E> {
-    /// The trace as text for people: one line per entry, then the bit legend and the verdict
-    /// (issue 5 sim-run).
+    /// The trace as text for people: one line per entry, then the bit legend and the verdict.
     pub fn to_text(&self) -> String {
         use fmt::Write as _;
         let mut out = format!("{} {}\n\n", self.family, self.model);
@@ -658,7 +657,7 @@ impl<E: fmt::Display> Trace<E> {
 
 // ---------------------------------------------------------------------- runner
 
-/// How a script is played (issue 5 sim-run).
+/// How a script is played.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RunOptions {
     /// A sample every this many ms besides the changes; 0: changes only.
@@ -682,24 +681,24 @@ impl Default for RunOptions {
     }
 }
 
-/// Collects trace entries while a script plays (issue 5 sim-run).
+/// Collects trace entries while a script plays.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recorder<E> {
     entries: Vec<Entry<E>>,
 }
 
 impl<E> Recorder<E> {
-    /// Records `what` at `t_us` (issue 5 sim-run).
+    /// Records `what` at `t_us`.
     pub fn push(&mut self, t_us: Micros, what: What<E>) {
         self.entries.push(Entry { t_us, what });
     }
 
-    /// Records a model event (issue 5 sim-run).
+    /// Records a model event.
     pub fn event(&mut self, t_us: Micros, event: E) {
         self.push(t_us, What::Event { event });
     }
 
-    /// Records an answer on a parameter channel (issue 5 sim-run).
+    /// Records an answer on a parameter channel.
     pub fn answer(&mut self, t_us: Micros, channel: String, answer: String, meaning: String) {
         self.push(
             t_us,
@@ -712,7 +711,7 @@ impl<E> Recorder<E> {
     }
 }
 
-/// A family's reference model as a script runner sees it (issue 5 sim-run): the master's
+/// A family's reference model as a script runner sees it: the master's
 /// cyclic output, the family's commands, the environment and what the drive shows.
 pub trait Simulated {
     /// The family's script commands.
@@ -738,8 +737,7 @@ pub trait Simulated {
     fn status_width(&self) -> u32;
 }
 
-/// What playing a script produced; the family adds its name and model to make a [`Trace`]
-/// (issue 5 sim-run).
+/// What playing a script produced; the family adds its name and model to make a [`Trace`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Played<E> {
     /// Everything that happened, in time order.
@@ -792,7 +790,7 @@ impl Sampler {
     }
 }
 
-/// Plays `script` on `sim` (issue 5 sim-run).
+/// Plays `script` on `sim`.
 ///
 /// The master's output goes out once per bus cycle from time 0; each line acts at its time,
 /// in file order, before the cycle of that time. Without an `end` line the run goes on after
@@ -885,7 +883,7 @@ pub fn play<S: Simulated>(
 }
 
 /// A unit variant's name in kebab case, from its `Debug` form: `LimitReached` →
-/// `limit-reached` (issue 5 sim-run).
+/// `limit-reached`.
 pub fn kebab<T: fmt::Debug>(v: &T) -> String {
     let mut out = String::new();
     for (i, c) in format!("{v:?}").chars().enumerate() {
@@ -901,7 +899,7 @@ pub fn kebab<T: fmt::Debug>(v: &T) -> String {
     out
 }
 
-/// A core event as a short sentence for text traces (issue 5 sim-run).
+/// A core event as a short sentence for text traces.
 pub fn describe_core(e: &CoreEvent) -> String {
     match e {
         CoreEvent::RunStarted {
@@ -935,7 +933,7 @@ pub fn describe_core(e: &CoreEvent) -> String {
     }
 }
 
-/// µs as milliseconds, with three decimals only when not whole (issue 5 sim-run).
+/// µs as milliseconds, with three decimals only when not whole.
 fn format_ms(us: Micros) -> String {
     if us % 1000 == 0 {
         (us / 1000).to_string()

@@ -1,4 +1,4 @@
-//! Benchmark of the PSD4xx reference drive on virtual time (issue 5): simulated seconds per
+//! Benchmark of the PSD4xx reference drive on virtual time: simulated seconds per
 //! wall-clock second for positioning runs, (a) with a controller sending one output image per
 //! 1 ms bus cycle and reading the input image back, as `drivespec sim-run` and the
 //! conformance runner do, and (b) with the drive left to itself between commands

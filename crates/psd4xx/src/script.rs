@@ -1,5 +1,5 @@
 //! `sim-run` for the PSD4xx: the family's script commands and the runner that plays a
-//! script on the reference [`Drive`] on virtual time (issue 5 "Done when").
+//! script on the reference [`Drive`] on virtual time.
 //!
 //! The line grammar, environment changes and expectations are the shared ones of
 //! [`drivespec_positioner::script`]; the PSD4xx commands are:
@@ -65,7 +65,7 @@ pub enum PsdCommand {
     PowerCycle,
 }
 
-/// The PSD4xx script commands, parsed against the codec tables (issue 5 sim-run).
+/// The PSD4xx script commands, parsed against the codec tables.
 #[derive(Debug, Clone, Copy)]
 pub struct PsdDialect<'r> {
     rules: &'r Rules,
@@ -224,7 +224,7 @@ impl fmt::Display for TraceEvent {
     }
 }
 
-/// Why a script cannot be run (issue 5 sim-run).
+/// Why a script cannot be run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum RunError {
@@ -236,8 +236,7 @@ pub enum RunError {
     Script(#[from] ScriptError),
 }
 
-/// The reference drive with the controller's output image, as the script runner drives it
-/// (issue 5 sim-run).
+/// The reference drive with the controller's output image, as the script runner drives it.
 #[derive(Debug, Clone)]
 pub struct PsdSim {
     drive: Drive,
@@ -390,7 +389,7 @@ impl Simulated for PsdSim {
     }
 }
 
-/// Parses `text` and plays it on a drive built from `config` (issue 5 sim-run).
+/// Parses `text` and plays it on a drive built from `config`.
 pub fn run_text(
     spec: &Spec,
     config: DriveConfig,
@@ -402,7 +401,7 @@ pub fn run_text(
     run(spec, config, &script, opts)
 }
 
-/// Plays `script` on a drive built from `config` and returns the trace (issue 5 sim-run).
+/// Plays `script` on a drive built from `config` and returns the trace.
 ///
 /// The controller sends one output image per bus cycle from time 0; each line acts at its
 /// time, in file order. Without an `end` line the run goes on after the last line until the
@@ -438,7 +437,7 @@ pub fn run(
     })
 }
 
-/// Parses a script with the PSD4xx commands of `rules` (issue 5 sim-run).
+/// Parses a script with the PSD4xx commands of `rules`.
 pub fn parse(rules: &Rules, text: &str) -> Result<Script<PsdCommand>, ScriptError> {
     Script::parse(text, &PsdDialect::new(rules))
 }

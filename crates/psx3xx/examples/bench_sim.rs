@@ -1,4 +1,4 @@
-//! Benchmark of the PSx3xx reference drive on virtual time (issue 5): simulated seconds per
+//! Benchmark of the PSx3xx reference drive on virtual time: simulated seconds per
 //! wall-clock second for positioning runs, (a) with a master sending one process output
 //! image per bus cycle and reading the input image back, as `drivespec sim-run psx3xx` (1 ms)
 //! and an IO-Link master at the device's MinCycleTime (8 ms, ISDU 0 sub 3) do, and (b) with

@@ -1,5 +1,5 @@
 //! `sim-run` for the PSx3xx: the family's script commands and the runner that plays a
-//! script on the reference [`Drive`] on virtual time (issue 5 "Done when").
+//! script on the reference [`Drive`] on virtual time.
 //!
 //! The line grammar, environment changes and expectations are the shared ones of
 //! [`drivespec_positioner::script`]; the PSx3xx commands are:
@@ -67,7 +67,7 @@ pub enum PsxCommand {
     Leds,
 }
 
-/// The PSx3xx script commands, parsed against the codec tables (issue 5 sim-run).
+/// The PSx3xx script commands, parsed against the codec tables.
 #[derive(Debug, Clone, Copy)]
 pub struct PsxDialect<'a, 's> {
     rules: &'a Rules<'s>,
@@ -259,7 +259,7 @@ impl fmt::Display for TraceEvent {
     }
 }
 
-/// Why a script cannot be run (issue 5 sim-run).
+/// Why a script cannot be run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum RunError {
@@ -271,8 +271,7 @@ pub enum RunError {
     Script(#[from] ScriptError),
 }
 
-/// The reference drive with the master's process output, as the script runner drives it
-/// (issue 5 sim-run).
+/// The reference drive with the master's process output, as the script runner drives it.
 #[derive(Debug, Clone)]
 pub struct PsxSim<'s> {
     drive: Drive<'s>,
@@ -447,12 +446,12 @@ impl<'s> Simulated for PsxSim<'s> {
     }
 }
 
-/// Parses a script with the PSx3xx commands of `rules` (issue 5 sim-run).
+/// Parses a script with the PSx3xx commands of `rules`.
 pub fn parse(rules: &Rules<'_>, text: &str) -> Result<Script<PsxCommand>, ScriptError> {
     Script::parse(text, &PsxDialect::new(rules))
 }
 
-/// Parses `text` and plays it on a drive built from `config` (issue 5 sim-run).
+/// Parses `text` and plays it on a drive built from `config`.
 pub fn run_text(
     spec: &Spec,
     config: DriveConfig,

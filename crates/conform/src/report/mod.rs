@@ -1,7 +1,7 @@
-//! The run report: one data model (serialised as the JSON report, schema in `REPORTS.md`),
-//! rendered as JUnit XML and as a self-contained HTML page. Files are written atomically:
-//! to a temporary file in the same folder, flushed, then renamed over the target, so a reader
-//! never sees half a report.
+//! The run report: one data model (serialised as the JSON report, schema in
+//! `crates/conform/README.md`, "JSON report"), rendered as JUnit XML and as a self-contained
+//! HTML page. Files are written atomically: to a temporary file in the same folder, flushed,
+//! then renamed over the target, so a reader never sees half a report.
 
 mod html;
 mod junit;
@@ -15,7 +15,7 @@ use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
 
-/// Name and version of the JSON schema (`REPORTS.md`).
+/// Name and version of the JSON schema (`crates/conform/README.md`, "JSON report").
 pub const SCHEMA: &str = "drivespec-conform/1";
 
 /// A case's final status, with expectations applied.
