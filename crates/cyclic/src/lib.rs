@@ -1,5 +1,5 @@
 //! The cyclic-exchange protocol `drivespec-cyclic/1` between the runner and a PSD4xx or PSx3xx
-//! simulator or hardware-in-the-loop adapter (README "Cyclic-exchange protocol").
+//! simulator or hardware-in-the-loop adapter (README "Protocol").
 //!
 //! One request line in, one reply line out, ASCII, `\n`-terminated, over any
 //! [`drivespec_link::Link`] (tcp, exec, serial). The crate does no I/O of its own: lines are

@@ -1,5 +1,5 @@
 //! `drivespec sim psd4xx|psx3xx`: a reference model served on the cyclic-exchange protocol
-//! `drivespec-cyclic/1` (crates/conform/README.md, "Cyclic-exchange protocol").
+//! `drivespec-cyclic/1` (crates/cyclic/README.md).
 //!
 //! Any [`Server`] is served, so every family with a cyclic server joins by naming it in
 //! [`with_cyclic_server`]. Each TCP connection, the pseudo-terminal and the stdio stream are one
