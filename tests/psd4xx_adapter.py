@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A minimal PSD4xx for `drivespec conform psd4xx --dut exec:...` (protocol drivespec-cyclic/1,
-crates/conform/README.md "Cyclic-exchange protocol").
+crates/cyclic/README.md).
 
 It implements the PKW handshake for four parameters (1 status, 3 actual position read-only
 here, 44 positioning window, 45 loop length), records for the same, the toggle bit and a

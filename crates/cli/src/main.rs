@@ -7,6 +7,7 @@ mod hpd_cmd;
 mod pd_cmd;
 mod sim_cmd;
 mod simrun_cmd;
+mod spec_build;
 mod spec_cmd;
 
 use anyhow::{anyhow, bail, Result};

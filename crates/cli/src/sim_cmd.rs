@@ -1,9 +1,9 @@
-//! `drivespec sim`: argument parsing and printing around `drivespec_conform::serve`.
+//! `drivespec sim`: argument parsing and printing around `drivespec_sim`.
 
 use crate::{Context, Outcome};
 use anyhow::{bail, Context as _, Result};
-use drivespec_conform::cyclic::Server;
-use drivespec_conform::serve::{self, DeviceOptions, Faults, Options, ServedDevice, Stats, Stop};
+use drivespec_cyclic::Server;
+use drivespec_sim::{DeviceOptions, Faults, Options, ServedDevice, Stats, Stop};
 use drivespec_spec::FamilyId;
 use std::io::Write;
 use std::net::TcpListener;
@@ -90,7 +90,7 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
         bail!("--corrupt-images is for the cyclic-exchange families (psd4xx, psx3xx); hpd takes --corrupt-checksums");
     }
     let spec = Arc::new(ctx.spec()?);
-    let device = serve::device(
+    let device = drivespec_sim::device(
         spec,
         family,
         &DeviceOptions {
@@ -133,12 +133,12 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
             log,
             "drivespec sim: test it with: drivespec conform {family} --dut tcp:{local}"
         );
-        serve::serve_tcp(listener, device, &opts, &stop, &mut log)?
+        drivespec_sim::serve_tcp(listener, device, &opts, &stop, &mut log)?
     } else if args.pty {
         serve_pty(device, &opts, &stop, &mut log, family, banner)?
     } else {
         banner(&mut log, device.as_ref(), "stdin/stdout");
-        serve::serve_stdio(device, &opts, &stop, &mut log)?
+        drivespec_sim::serve_stdio(device, &opts, &stop, &mut log)?
     };
     print_stats(&mut log, &stats);
     Ok(Outcome::Pass)
@@ -166,7 +166,7 @@ fn run_cyclic(
         max_clients: None,
         check_bit_rate: false,
     };
-    serve::with_cyclic_server(&spec, family, args.model.as_deref(), |server, name| {
+    drivespec_sim::with_cyclic_server(&spec, family, args.model.as_deref(), |server, name| {
         serve_cyclic(args, family, server, name, &opts)
     })?
 }
@@ -205,12 +205,12 @@ fn serve_cyclic(
             log,
             "drivespec sim: test it with: drivespec conform {family} --dut tcp:{local}"
         );
-        serve::serve_cyclic_tcp(listener, server, opts, &stop, &mut log)?
+        drivespec_sim::serve_cyclic_tcp(listener, server, opts, &stop, &mut log)?
     } else if args.pty {
         serve_cyclic_pty(server, opts, &stop, &mut log, family, banner)?
     } else {
         banner(&mut log, "stdin/stdout");
-        serve::serve_cyclic_stdio(server, opts, &stop, &mut log)?
+        drivespec_sim::serve_cyclic_stdio(server, opts, &stop, &mut log)?
     };
     let _ = writeln!(
         log,
@@ -239,7 +239,7 @@ fn serve_cyclic_pty(
     family: FamilyId,
     banner: impl Fn(&mut dyn Write, &str),
 ) -> Result<Stats> {
-    let pty = serve::Pty::open(None)?;
+    let pty = drivespec_sim::Pty::open(None)?;
     print_line(pty.path());
     banner(log, pty.path());
     let _ = writeln!(
@@ -247,7 +247,9 @@ fn serve_cyclic_pty(
         "drivespec sim: test it with: drivespec conform {family} --dut serial:{}",
         pty.path()
     );
-    Ok(serve::serve_cyclic_pty(&pty, server, opts, stop, log)?)
+    Ok(drivespec_sim::serve_cyclic_pty(
+        &pty, server, opts, stop, log,
+    )?)
 }
 
 #[cfg(not(unix))]
@@ -271,7 +273,7 @@ fn serve_pty(
     family: FamilyId,
     banner: impl Fn(&mut dyn Write, &dyn ServedDevice, &str),
 ) -> Result<Stats> {
-    let pty = serve::Pty::open(device.bit_rate())?;
+    let pty = drivespec_sim::Pty::open(device.bit_rate())?;
     // The one line on stdout: the path a serial client opens.
     print_line(pty.path());
     banner(log, device.as_ref(), pty.path());
@@ -280,7 +282,7 @@ fn serve_pty(
         "drivespec sim: test it with: drivespec conform {family} --dut serial:{}",
         pty.path()
     );
-    Ok(serve::serve_pty(&pty, device, opts, stop, log)?)
+    Ok(drivespec_sim::serve_pty(&pty, device, opts, stop, log)?)
 }
 
 #[cfg(not(unix))]

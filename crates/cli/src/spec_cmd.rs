@@ -1,11 +1,12 @@
 //! `drivespec spec …`: browse and check the machine-readable spec.
 
-use crate::{json, Context, Format, Outcome};
+use crate::{json, spec_build, Context, Format, Outcome};
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, Subcommand};
 use drivespec_spec::{DeviceModel, Family, FamilyId, Level, Parameter, Ranges, Spec};
 use serde::Serialize;
 use std::fmt::Write as _;
+use std::sync::Arc;
 
 /// Arguments of `drivespec spec`.
 #[derive(Args)]
@@ -57,7 +58,8 @@ enum SpecCommand {
         /// hpd, psd4xx or psx3xx.
         device: String,
     },
-    /// Validate the spec; one line per problem, exit 1 when there is any.
+    /// Validate the spec and build every suite's cases and every simulator from it; one line
+    /// per problem, exit 1 when there is any.
     Check,
 }
 
@@ -115,20 +117,22 @@ fn unreachable_check() -> Result<String> {
 
 fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Outcome {
     #[derive(Serialize)]
-    struct Report<'a> {
+    struct Report {
         ok: bool,
-        problems: Vec<ProblemJson<'a>>,
+        problems: Vec<ProblemJson>,
     }
     #[derive(Serialize)]
-    struct ProblemJson<'a> {
-        file: &'a str,
-        record: Option<&'a str>,
+    struct ProblemJson {
+        file: String,
+        record: Option<String>,
         message: String,
     }
-    let (ok, problems) = match &loaded {
-        Ok(_) => (true, Vec::new()),
-        Err(e) => (false, e.0.iter().collect()),
+    let loaded = loaded.map(Arc::new);
+    let (problems, built) = match &loaded {
+        Ok(spec) => (Vec::new(), spec_build::problems(spec)),
+        Err(e) => (e.0.iter().collect(), Vec::new()),
     };
+    let ok = problems.is_empty() && built.is_empty();
     match format {
         Format::Json => {
             let report = Report {
@@ -136,10 +140,15 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
                 problems: problems
                     .iter()
                     .map(|p| ProblemJson {
-                        file: &p.file,
-                        record: p.record.as_deref(),
+                        file: p.file.clone(),
+                        record: p.record.clone(),
                         message: p.kind.to_string(),
                     })
+                    .chain(built.iter().map(|p| ProblemJson {
+                        file: p.file().to_owned(),
+                        record: Some(p.record()),
+                        message: p.message(),
+                    }))
                     .collect(),
             };
             println!("{}", json(&report));
@@ -148,7 +157,10 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
             for p in &problems {
                 println!("{p}");
             }
-            if let Ok(spec) = &loaded {
+            for p in &built {
+                println!("{p}");
+            }
+            if let (Ok(spec), true) = (&loaded, ok) {
                 for f in spec.families() {
                     println!(
                         "{}: {} parameters, {} models, {} bitfields, {} requirements, {} errata, {} vectors",

@@ -117,6 +117,83 @@ fn check_json_is_machine_readable() {
     assert_eq!(v["problems"].as_array().map(Vec::len), Some(0));
 }
 
+/// `spec check` on a copy of the builtin spec in which `edit` changed the family folder
+/// `family`'s files.
+fn check_edited(name: &str, family: &str, edit: impl Fn(&str) -> String) -> Run {
+    let dir = std::env::temp_dir().join(format!("drivespec-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec");
+    copy_dir(std::path::Path::new(src), &dir);
+    let mut changed = 0;
+    for entry in std::fs::read_dir(dir.join(family)).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let edited = edit(&text);
+            if edited != text {
+                std::fs::write(&path, edited).unwrap();
+                changed += 1;
+            }
+        }
+    }
+    let r = drivespec(&["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(changed, 1, "the edit {name} changed {changed} files");
+    r
+}
+
+/// `text` without the `[[requirement]]` record whose id is `id`.
+fn without_requirement(text: &str, id: &str) -> String {
+    let line = format!("id = {id:?}\n");
+    let Some(at) = text.find(&line) else {
+        return text.to_owned();
+    };
+    let start = text[..at].rfind("[[requirement]]").unwrap();
+    let end = text[at..].find("\n[[").map_or(text.len(), |e| at + e + 1);
+    format!("{}{}", &text[..start], &text[end..])
+}
+
+#[test]
+fn a_spec_edit_that_breaks_case_generation_fails_check() {
+    // Only a PSx3xx case cites this requirement: the spec loads, the cases cannot be made.
+    let r = check_edited("no-case-requirement", "psx3xx", |t| {
+        without_requirement(t, "PSX-ISDU-181-BIT4")
+    });
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    assert!(!r.stdout.contains("spec ok"), "{}", r.stdout);
+    let lines: Vec<&str> = r.stdout.lines().collect();
+    assert!(
+        lines.iter().any(|l| l.starts_with(
+            "psx3xx: model \"PSE312-8\": the conformance cases cannot be generated: "
+        ) && l.contains("unknown requirement PSX-ISDU-181-BIT4")),
+        "{}",
+        r.stdout
+    );
+    // Every problem is a PSx3xx model's cases: the simulator does not need the requirement.
+    assert!(
+        lines.iter().all(|l| l.starts_with("psx3xx: model ")
+            && l.contains(": the conformance cases cannot be generated: ")),
+        "{}",
+        r.stdout
+    );
+}
+
+#[test]
+fn a_spec_edit_that_breaks_the_simulator_fails_check() {
+    // The reference PSx3xx drive takes the orange LED's acknowledge time from this pattern.
+    let r = check_edited("no-led-dark", "psx3xx", |t| {
+        t.replace("pattern = \"dark-250ms\"", "pattern = \"dark\"")
+    });
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    assert!(
+        r.stdout.lines().any(|l| l
+            == "psx3xx: model \"PSE312-8\": the simulator cannot be built: the reference model \
+                cannot be built: spec: no dark-<n>ms state of the orange LED"),
+        "{}",
+        r.stdout
+    );
+}
+
 fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
     std::fs::create_dir_all(to).unwrap();
     for entry in std::fs::read_dir(from).unwrap() {

@@ -19,8 +19,8 @@
 
 use drivespec_conform::dut::Dut;
 use drivespec_conform::report::Status;
-use drivespec_conform::serve::{self, DeviceOptions, Options, Stop};
 use drivespec_conform::{run, Progress, Summary};
+use drivespec_sim::{DeviceOptions, Options, Stop};
 use drivespec_spec::{FamilyId, Spec};
 use std::io::{Read, Write};
 use std::sync::Arc;
@@ -180,8 +180,9 @@ fn main() {
     );
 
     // 3. The full HPD suite against the served model on a pty, real time.
-    let dev = serve::device(spec.clone(), FamilyId::Hpd, &DeviceOptions::default()).unwrap();
-    let pty = serve::Pty::open(dev.bit_rate()).unwrap();
+    let dev =
+        drivespec_sim::device(spec.clone(), FamilyId::Hpd, &DeviceOptions::default()).unwrap();
+    let pty = drivespec_sim::Pty::open(dev.bit_rate()).unwrap();
     let path = pty.path().to_owned();
     let stop = Stop::new();
     let server = {
@@ -191,7 +192,7 @@ fn main() {
                 time_limit: Some(Duration::from_secs(600)),
                 ..Options::default()
             };
-            serve::serve_pty(&pty, dev, &opts, &stop, &mut std::io::sink())
+            drivespec_sim::serve_pty(&pty, dev, &opts, &stop, &mut std::io::sink())
         })
     };
     let dut = Dut::Serial {
@@ -278,7 +279,8 @@ fn main() {
     // 5. The same exchanges over TCP on loopback (`drivespec sim hpd --listen`).
     let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = listener.local_addr().unwrap();
-    let dev = serve::device(spec.clone(), FamilyId::Hpd, &DeviceOptions::default()).unwrap();
+    let dev =
+        drivespec_sim::device(spec.clone(), FamilyId::Hpd, &DeviceOptions::default()).unwrap();
     let stop = Stop::new();
     let server = {
         let stop = stop.clone();
@@ -287,7 +289,7 @@ fn main() {
                 time_limit: Some(Duration::from_secs(600)),
                 ..Options::default()
             };
-            serve::serve_tcp(listener, dev, &opts, &stop, &mut std::io::sink())
+            drivespec_sim::serve_tcp(listener, dev, &opts, &stop, &mut std::io::sink())
         })
     };
     let tcp = Dut::Tcp {

@@ -7,6 +7,7 @@
 //! | `tcp:HOST:PORT` | a raw byte stream (ser2net, a simulator) |
 //! | `exec:COMMAND ARGS` | a subprocess speaking the protocol on stdin/stdout |
 
+pub use drivespec_link::shell_quote;
 use std::fmt;
 use std::str::FromStr;
 
@@ -185,18 +186,6 @@ pub fn split_command(s: &str) -> Result<Vec<String>, &'static str> {
         words.push(cur);
     }
     Ok(words)
-}
-
-/// A word quoted for a POSIX shell when it needs it.
-pub fn shell_quote(w: &str) -> String {
-    let plain = !w.is_empty()
-        && w.chars()
-            .all(|c| c.is_ascii_alphanumeric() || "-_./:=@%+,".contains(c));
-    if plain {
-        w.to_owned()
-    } else {
-        format!("'{}'", w.replace('\'', r"'\''"))
-    }
 }
 
 #[cfg(test)]

@@ -5,7 +5,8 @@
 //! - [`suite`]: the [`suite::Suite`]/[`suite::Session`] traits a family implements; HPD in
 //!   [`hpd`], PSD4xx in [`psd4xx`], PSx3xx in [`psx3xx`] (the last two over the
 //!   cyclic-exchange protocol of [`cyclic`]).
-//! - [`link`]: the transports (`sim`, `serial`, `tcp`, `exec`) behind [`link::Link`].
+//! - [`link`]: the transports (`serial`, `tcp`, `exec`) behind [`link::Link`] (the crate
+//!   `drivespec-link`); `--dut sim` runs the reference models of `drivespec-sim`.
 //! - [`runner`]: selection, expectations, progress, reports; [`runner::run`] is what the CLI
 //!   calls.
 //! - [`report`]: the report model and its renderings (schema in the crate
@@ -19,15 +20,15 @@ pub mod cyclic;
 pub mod dut;
 pub mod fuzz;
 pub mod hpd;
-pub mod link;
 pub mod plot;
 pub mod psd4xx;
 pub mod psx3xx;
 pub mod report;
-mod rng;
 pub mod runner;
 pub mod select;
-pub mod serve;
 pub mod suite;
+
+pub use drivespec_link as link;
+use drivespec_sim::rng;
 
 pub use runner::{run, ConformError, Options, Progress, Summary};

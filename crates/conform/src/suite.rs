@@ -42,6 +42,17 @@ pub enum SetupError {
     Spec(String),
 }
 
+impl From<drivespec_sim::reference::ReferenceError> for SetupError {
+    fn from(e: drivespec_sim::reference::ReferenceError) -> SetupError {
+        match e {
+            drivespec_sim::reference::ReferenceError::UnknownModel { .. } => {
+                SetupError::Usage(e.to_string())
+            }
+            other => SetupError::Spec(other.to_string()),
+        }
+    }
+}
+
 /// The cases of one family.
 pub trait Suite {
     /// The family.

@@ -12,8 +12,8 @@
 mod support;
 
 use drivespec_conform::fuzz::{self, FindingClass, Options};
-use drivespec_conform::link::SimLink;
 use drivespec_conform::Progress;
+use drivespec_sim::SimLink;
 use support::mutants::{mutants, spec, Kind, Mutant};
 
 /// Sequences each mutant gets.

@@ -12,8 +12,8 @@ mod support;
 
 use drivespec_conform::dut::Dut;
 use drivespec_conform::fuzz::{self, Action, Compare, Options, Replay, Step};
-use drivespec_conform::link::SimLink;
 use drivespec_conform::Progress;
+use drivespec_sim::SimLink;
 use std::path::PathBuf;
 use support::mutants::{spec, Kind, Mutant};
 

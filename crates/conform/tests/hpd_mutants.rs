@@ -13,9 +13,9 @@ mod support;
 
 use drivespec_conform::case::Outcome;
 use drivespec_conform::hpd::HpdSuite;
-use drivespec_conform::link::SimLink;
 use drivespec_conform::select::Pattern;
 use drivespec_conform::suite::{Session, Settings, Suite};
+use drivespec_sim::SimLink;
 use support::mutants::{mutants, spec, Mutant};
 
 #[test]

@@ -9,9 +9,7 @@
 )]
 
 use drivespec_conform::dut::Dut;
-use drivespec_conform::psd4xx::Psd4xxSuite;
 use drivespec_conform::report::Status;
-use drivespec_conform::suite::Settings;
 use drivespec_conform::{run, Options, Progress};
 use drivespec_spec::{FamilyId, Spec};
 use std::io::BufReader;
@@ -57,8 +55,8 @@ fn tcp_against_the_reference_server_passes() {
     let addr = listener.local_addr().unwrap();
     let server_spec = Spec::builtin().unwrap();
     let t = std::thread::spawn(move || {
-        let suite = Psd4xxSuite::new(&server_spec, &Settings::default()).unwrap();
-        let mut server = suite.server();
+        let reference = drivespec_sim::reference::psd4xx(&server_spec, None).unwrap();
+        let mut server = reference.server(FamilyId::Psd4xx);
         let (stream, _) = listener.accept().unwrap();
         stream.set_nodelay(true).unwrap();
         let reader = BufReader::new(stream.try_clone().unwrap());

@@ -1,5 +1,5 @@
 //! PSx3xx end to end over the cyclic-exchange protocol: a real TCP socket on 127.0.0.1
-//! serving the reference drive (`Psx3xxSuite::server`, the same `Server` as `sim`) with the
+//! serving the reference drive (`drivespec_sim::reference`, the same `Server` as `sim`) with the
 //! ISDU requests and environment injections on the wire, and the HTML report's plots.
 #![allow(
     clippy::unwrap_used,
@@ -9,7 +9,6 @@
 )]
 
 use drivespec_conform::dut::Dut;
-use drivespec_conform::psx3xx::Psx3xxSuite;
 use drivespec_conform::report::Status;
 use drivespec_conform::suite::Settings;
 use drivespec_conform::{run, Options, Progress};
@@ -23,12 +22,8 @@ fn serve(model: &'static str) -> String {
     let addr = listener.local_addr().unwrap();
     std::thread::spawn(move || {
         let spec = Spec::builtin().unwrap();
-        let settings = Settings {
-            model: Some(model.to_owned()),
-            ..Settings::default()
-        };
-        let suite = Psx3xxSuite::new(&spec, &settings).unwrap();
-        let mut server = suite.server();
+        let reference = drivespec_sim::reference::psx3xx(&spec, Some(model)).unwrap();
+        let mut server = reference.server(FamilyId::Psx3xx);
         let (stream, _) = listener.accept().unwrap();
         stream.set_nodelay(true).unwrap();
         let reader = BufReader::new(stream.try_clone().unwrap());

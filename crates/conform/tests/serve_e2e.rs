@@ -1,4 +1,4 @@
-//! End to end through `drivespec_conform::serve` (what `drivespec sim` runs), in-process on a
+//! End to end through `drivespec_sim` (what `drivespec sim` runs), in-process on a
 //! thread: the serial transport over a real pseudo-terminal (baud changes included), TCP with
 //! clients one after another, and the fault-injection flags failing the cases they should.
 //! The `exec:` path (`drivespec sim --stdio`) is tested with the binary in
@@ -16,8 +16,8 @@
 
 use drivespec_conform::dut::Dut;
 use drivespec_conform::report::Status;
-use drivespec_conform::serve::{self, DeviceOptions, Faults, Options, ServeError, Stats, Stop};
 use drivespec_conform::{run, Progress, Summary};
+use drivespec_sim::{DeviceOptions, Faults, Options, ServeError, Stats, Stop};
 use drivespec_spec::{FamilyId, Spec};
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -34,8 +34,8 @@ fn spec() -> Arc<Spec> {
         .clone()
 }
 
-fn device() -> Box<dyn serve::ServedDevice> {
-    serve::device(spec(), FamilyId::Hpd, &DeviceOptions::default()).unwrap()
+fn device() -> Box<dyn drivespec_sim::ServedDevice> {
+    drivespec_sim::device(spec(), FamilyId::Hpd, &DeviceOptions::default()).unwrap()
 }
 
 fn options(faults: Faults) -> Options {
@@ -71,12 +71,12 @@ impl Drop for Served {
 #[cfg(unix)]
 fn serve_pty(faults: Faults) -> (Served, String) {
     let dev = device();
-    let pty = serve::Pty::open(dev.bit_rate()).unwrap();
+    let pty = drivespec_sim::Pty::open(dev.bit_rate()).unwrap();
     let path = pty.path().to_owned();
     let stop = Stop::new();
     let s = stop.clone();
     let handle = std::thread::spawn(move || {
-        serve::serve_pty(&pty, dev, &options(faults), &s, &mut std::io::sink())
+        drivespec_sim::serve_pty(&pty, dev, &options(faults), &s, &mut std::io::sink())
     });
     (
         Served {
@@ -94,7 +94,7 @@ fn serve_tcp(faults: Faults) -> (Served, SocketAddr) {
     let s = stop.clone();
     let dev = device();
     let handle = std::thread::spawn(move || {
-        serve::serve_tcp(listener, dev, &options(faults), &s, &mut std::io::sink())
+        drivespec_sim::serve_tcp(listener, dev, &options(faults), &s, &mut std::io::sink())
     });
     (
         Served {

@@ -1,6 +1,6 @@
 //! The device under test as a conformance session holds it: a [`Peer`] greeted with `HELLO`
 //! for one family and model, restarted after a transport failure, with the first failure of a
-//! case run kept for the fuzzer (README "Cyclic-exchange protocol").
+//! case run kept for the fuzzer (crates/cyclic/README.md).
 
 use super::{Env, Peer, PeerError, Reply, Request, VERSION};
 use drivespec_spec::FamilyId;

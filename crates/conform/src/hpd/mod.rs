@@ -28,11 +28,12 @@ pub use session::HpdSession;
 
 use crate::case::CaseInfo;
 use crate::dut::Dut;
-use crate::link::{ExecLink, Link, SerialLink, SimLink, TcpLink};
+use crate::link::{ExecLink, Link, SerialLink, TcpLink};
 use crate::suite::{Session, Settings, SetupError, Suite};
 use drivespec_hpd::model::{Drive, DriveConfig};
 use drivespec_hpd::plc::PlcCodec;
 use drivespec_hpd::FrameRules;
+use drivespec_sim::SimLink;
 use drivespec_spec::hpd::Protocol;
 use drivespec_spec::{Family, FamilyId, Spec};
 use step::HpdCase;

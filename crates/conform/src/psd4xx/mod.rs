@@ -29,12 +29,12 @@ use crate::dut::Dut;
 use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, Settings, SetupError, Suite};
 use cases::PsdCase;
-use drivespec_psd4xx::model::{Drive, DriveConfig};
+use drivespec_psd4xx::model::Drive;
+use drivespec_sim::reference::{self, Reference};
 use drivespec_spec::{Family, FamilyId, Spec};
 
-/// The device model `--model` selects when none is given: an ungeared PSD 401 (the model the
-/// spec's vectors assume).
-pub const DEFAULT_MODEL: &str = "PSD401-5V";
+/// The device model `--model` selects when none is given.
+pub use drivespec_sim::reference::PSD4XX_DEFAULT_MODEL as DEFAULT_MODEL;
 
 /// Bus cycle of the runner (µs): one output image and one input image per cycle.
 pub const CYCLE_US: u64 = 10_000;
@@ -42,8 +42,7 @@ pub const CYCLE_US: u64 = 10_000;
 /// The PSD4xx suite for one device model.
 pub struct Psd4xxSuite<'s> {
     family: &'s Family,
-    model: String,
-    baseline: Drive,
+    reference: Reference<'s, Drive>,
     infos: Vec<CaseInfo>,
     cases: Vec<PsdCase>,
 }
@@ -52,21 +51,12 @@ impl<'s> Psd4xxSuite<'s> {
     /// Generates the cases for `settings.model` (default [`DEFAULT_MODEL`]).
     pub fn new(spec: &'s Spec, settings: &Settings) -> Result<Psd4xxSuite<'s>, SetupError> {
         let family = spec.family(FamilyId::Psd4xx);
-        let query = settings.model.as_deref().unwrap_or(DEFAULT_MODEL);
-        let model = family.model(query).ok_or_else(|| {
-            let known: Vec<&str> = family.models.iter().map(|m| m.id.as_str()).collect();
-            SetupError::Usage(format!(
-                "unknown PSD4xx model {query:?}; known: {}",
-                known.join(", ")
-            ))
-        })?;
-        let baseline = Drive::new(spec, DriveConfig::new(&model.id))
-            .map_err(|e| SetupError::Spec(e.to_string()))?;
-        let (infos, cases) = cases::generate(family, model, &baseline).map_err(SetupError::Spec)?;
+        let reference = reference::psd4xx(spec, settings.model.as_deref())?;
+        let (infos, cases) =
+            cases::generate(family, reference.model, &reference.drive).map_err(SetupError::Spec)?;
         Ok(Psd4xxSuite {
             family,
-            model: model.id.clone(),
-            baseline,
+            reference,
             infos,
             cases,
         })
@@ -74,21 +64,17 @@ impl<'s> Psd4xxSuite<'s> {
 
     /// The device model the cases are for.
     pub fn model(&self) -> &str {
-        &self.model
+        &self.reference.model.id
     }
 
     /// The reference drive as every case expects the device at its start.
     pub fn reference(&self) -> &Drive {
-        &self.baseline
+        &self.reference.drive
     }
 
     /// A server on the reference drive (what `sim` runs, and what tests serve over tcp).
     pub fn server(&self) -> Server<'static> {
-        Server::new(
-            &format!("drivespec reference {}", self.model),
-            FamilyId::Psd4xx.as_str(),
-            Box::new(self.baseline.clone()),
-        )
+        self.reference.server(FamilyId::Psd4xx)
     }
 
     /// Opens a session on a peer of the caller's (tests, embedding tools).
@@ -109,7 +95,7 @@ impl<'s> Psd4xxSuite<'s> {
         const TIMEOUT_US: u64 = 2_000_000;
         Ok(match dut {
             Dut::Sim { .. } => Box::new(LocalPeer::new(
-                &format!("sim:{}", self.model),
+                &format!("sim:{}", self.reference.model.id),
                 self.server(),
             )),
             Dut::Serial { path, baud } => {

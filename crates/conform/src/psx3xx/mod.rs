@@ -32,27 +32,17 @@ use crate::dut::Dut;
 use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, Settings, SetupError, Suite};
 use cases::PsxCase;
-use drivespec_psx3xx::model::{Drive, DriveConfig};
+use drivespec_psx3xx::model::Drive;
+use drivespec_sim::reference::{self, Reference};
 use drivespec_spec::{Family, FamilyId, Spec};
 
-/// The device model `--model` selects when none is given: the PSE 312-8 the spec's vectors
-/// assume (`spec/psx3xx/vectors/isdu.toml`).
-pub const DEFAULT_MODEL: &str = "PSE312-8";
-
-/// The model attribute holding the ISDU 79 model code (manual 3.1 ISDU 79).
-const MODEL_CODE: &str = "device_model_code";
-
-/// The ISDU 79 code the reference reports for the gearbox types whose code the manual does
-/// not document (PSX-ERRATUM-016, reading "list-incomplete"): a device reporting its own code
-/// differs in the cases that read ISDU 79 or the device ID, which then belong in its
-/// expectations file.
-pub const UNDOCUMENTED_CODE: u16 = 0;
+/// The device model `--model` selects when none is given.
+pub use drivespec_sim::reference::PSX3XX_DEFAULT_MODEL as DEFAULT_MODEL;
 
 /// The PSx3xx suite for one device model.
 pub struct Psx3xxSuite<'s> {
     family: &'s Family,
-    model: String,
-    baseline: Drive<'s>,
+    reference: Reference<'s, Drive<'s>>,
     cycle_us: u64,
     infos: Vec<CaseInfo>,
     cases: Vec<PsxCase>,
@@ -62,27 +52,13 @@ impl<'s> Psx3xxSuite<'s> {
     /// Generates the cases for `settings.model` (default [`DEFAULT_MODEL`]).
     pub fn new(spec: &'s Spec, settings: &Settings) -> Result<Psx3xxSuite<'s>, SetupError> {
         let family = spec.family(FamilyId::Psx3xx);
-        let query = settings.model.as_deref().unwrap_or(DEFAULT_MODEL);
-        let model = family.model(query).ok_or_else(|| {
-            let known: Vec<&str> = family.models.iter().map(|m| m.id.as_str()).collect();
-            SetupError::Usage(format!(
-                "unknown PSx3xx model {query:?}; known: {}",
-                known.join(", ")
-            ))
-        })?;
-        let mut config = DriveConfig::new(&model.id);
-        if model.attribute(MODEL_CODE).is_none() {
-            // PSX-ERRATUM-016: the ISDU 79 code of this gearbox type is undocumented.
-            config.model_code = Some(UNDOCUMENTED_CODE);
-        }
-        let baseline = Drive::new(spec, config).map_err(|e| SetupError::Spec(e.to_string()))?;
-        let cycle_us = min_cycle_us(&baseline)?;
-        let (infos, cases) =
-            cases::generate(family, model, &baseline, cycle_us).map_err(SetupError::Spec)?;
+        let reference = reference::psx3xx(spec, settings.model.as_deref())?;
+        let cycle_us = min_cycle_us(&reference.drive)?;
+        let (infos, cases) = cases::generate(family, reference.model, &reference.drive, cycle_us)
+            .map_err(SetupError::Spec)?;
         Ok(Psx3xxSuite {
             family,
-            model: model.id.clone(),
-            baseline,
+            reference,
             cycle_us,
             infos,
             cases,
@@ -91,12 +67,12 @@ impl<'s> Psx3xxSuite<'s> {
 
     /// The device model the cases are for.
     pub fn model(&self) -> &str {
-        &self.model
+        &self.reference.model.id
     }
 
     /// The reference drive as every case expects the device at its start.
     pub fn reference(&self) -> &Drive<'s> {
-        &self.baseline
+        &self.reference.drive
     }
 
     /// The IO-Link cycle of the runner (µs): the device's MinCycleTime (PSX-DP-001).
@@ -106,11 +82,7 @@ impl<'s> Psx3xxSuite<'s> {
 
     /// A server on the reference drive (what `sim` runs, and what tests serve over tcp).
     pub fn server(&self) -> Server<'s> {
-        Server::new(
-            &format!("drivespec reference {}", self.model),
-            FamilyId::Psx3xx.as_str(),
-            Box::new(self.baseline.clone()),
-        )
+        self.reference.server(FamilyId::Psx3xx)
     }
 
     /// Opens a session on a peer of the caller's (tests, embedding tools).
@@ -131,7 +103,7 @@ impl<'s> Psx3xxSuite<'s> {
         const TIMEOUT_US: u64 = 2_000_000;
         Ok(match dut {
             Dut::Sim { .. } => Box::new(LocalPeer::new(
-                &format!("sim:{}", self.model),
+                &format!("sim:{}", self.reference.model.id),
                 self.server(),
             )),
             Dut::Serial { path, baud } => {

@@ -2,10 +2,11 @@
 //! or an erratum reading other than the adopted one), shared by the mutation test
 //! (`hpd_mutants.rs`) and the fuzzer tests (`fuzz_*.rs`).
 
-use drivespec_conform::link::{Micros, SimDevice};
+use drivespec_conform::link::Micros;
 use drivespec_hpd::model::{Drive, DriveConfig, Output};
 use drivespec_hpd::params::Target;
 use drivespec_hpd::{decode, parse, AckEnd, Data, FrameRules, Message, MessageKind, Status};
+use drivespec_sim::SimDevice;
 use drivespec_spec::{FamilyId, Readings, Spec};
 use std::sync::OnceLock;
 

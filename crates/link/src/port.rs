@@ -1,18 +1,39 @@
 //! The byte streams a served device talks on: every read waits at most the time given, every
 //! write is bounded.
 
-use super::ServeError;
 use std::io::{ErrorKind, Read, Write};
 use std::net::TcpStream;
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::Duration;
+
+/// Why a port cannot be opened or used.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PortError {
+    /// The transport cannot be set up.
+    #[error("cannot open {what}: {reason}")]
+    Open {
+        /// The transport.
+        what: String,
+        /// Why.
+        reason: String,
+    },
+    /// Reading or writing failed for good.
+    #[error("{what}: {reason}")]
+    Io {
+        /// What was being read or written.
+        what: &'static str,
+        /// The error.
+        reason: String,
+    },
+}
 
 /// How long a write to a client may take before the client counts as gone.
 const WRITE_LIMIT: Duration = Duration::from_secs(2);
 
 /// What a read gave.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Got {
+pub enum Got {
     /// This many bytes, at the start of the buffer.
     Bytes(usize),
     /// Nothing within the wait.
@@ -22,11 +43,11 @@ pub(crate) enum Got {
 }
 
 /// A byte stream to one client.
-pub(crate) trait Port {
+pub trait Port {
     /// Waits up to `wait` (may be zero) for bytes.
-    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, ServeError>;
+    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, PortError>;
     /// Writes `bytes`; `Ok(false)` when the client went away.
-    fn write(&mut self, bytes: &[u8]) -> Result<bool, ServeError>;
+    fn write(&mut self, bytes: &[u8]) -> Result<bool, PortError>;
     /// The bit rate the client set on the line, where the transport has one.
     fn bit_rate(&self) -> Option<u32> {
         None
@@ -35,11 +56,11 @@ pub(crate) trait Port {
 
 /// Waits up to `wait` for `fd` to have bytes (or an end) to read; false when it has none.
 #[cfg(unix)]
-pub(crate) fn readable(
+pub fn readable(
     fd: impl rustix::fd::AsFd,
     wait: Duration,
     what: &'static str,
-) -> Result<bool, ServeError> {
+) -> Result<bool, PortError> {
     use rustix::event::{poll, PollFd, PollFlags, Timespec};
     let timeout = Timespec {
         tv_sec: i64::try_from(wait.as_secs()).unwrap_or(i64::MAX),
@@ -49,7 +70,7 @@ pub(crate) fn readable(
     match poll(&mut fds, Some(&timeout)) {
         Ok(n) => Ok(n > 0),
         Err(rustix::io::Errno::INTR) => Ok(false),
-        Err(e) => Err(ServeError::Io {
+        Err(e) => Err(PortError::Io {
             what,
             reason: e.to_string(),
         }),
@@ -57,10 +78,11 @@ pub(crate) fn readable(
 }
 
 /// A TCP client.
-pub(crate) struct TcpPort(TcpStream);
+pub struct TcpPort(TcpStream);
 
 impl TcpPort {
-    pub(crate) fn new(s: TcpStream) -> std::io::Result<TcpPort> {
+    /// A port on an accepted client's stream (blocking, no small-packet delay, writes bounded).
+    pub fn new(s: TcpStream) -> std::io::Result<TcpPort> {
         s.set_nonblocking(false)?;
         s.set_nodelay(true)?;
         s.set_write_timeout(Some(WRITE_LIMIT))?;
@@ -71,7 +93,7 @@ impl TcpPort {
 }
 
 impl Port for TcpPort {
-    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, ServeError> {
+    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, PortError> {
         #[cfg(unix)]
         if !readable(&self.0, wait, "client socket")? {
             return Ok(Got::Idle);
@@ -81,7 +103,7 @@ impl Port for TcpPort {
             // A zero read time-out means "block forever" to the OS: never ask for it.
             let wait = wait.max(Duration::from_micros(1));
             if let Err(e) = self.0.set_read_timeout(Some(wait)) {
-                return Err(ServeError::Io {
+                return Err(PortError::Io {
                     what: "client socket",
                     reason: e.to_string(),
                 });
@@ -103,7 +125,7 @@ impl Port for TcpPort {
         }
     }
 
-    fn write(&mut self, bytes: &[u8]) -> Result<bool, ServeError> {
+    fn write(&mut self, bytes: &[u8]) -> Result<bool, PortError> {
         Ok(self
             .0
             .write_all(bytes)
@@ -113,7 +135,7 @@ impl Port for TcpPort {
 }
 
 /// A reader (on its own thread, so reads can time out) and a writer.
-pub(crate) struct StreamPort<'w> {
+pub struct StreamPort<'w> {
     from: Receiver<Vec<u8>>,
     /// Bytes received but not yet handed out.
     held: Vec<u8>,
@@ -121,7 +143,8 @@ pub(crate) struct StreamPort<'w> {
 }
 
 impl<'w> StreamPort<'w> {
-    pub(crate) fn new<R: Read + Send + 'static>(input: R, to: &'w mut dyn Write) -> StreamPort<'w> {
+    /// A port reading `input` on a thread of its own and writing to `to`.
+    pub fn new<R: Read + Send + 'static>(input: R, to: &'w mut dyn Write) -> StreamPort<'w> {
         let (tx, from) = mpsc::channel();
         std::thread::spawn(move || {
             let mut input = input;
@@ -148,7 +171,7 @@ impl<'w> StreamPort<'w> {
 }
 
 impl Port for StreamPort<'_> {
-    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, ServeError> {
+    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, PortError> {
         if self.held.is_empty() {
             match self.from.recv_timeout(wait) {
                 Ok(bytes) => self.held = bytes,
@@ -163,7 +186,7 @@ impl Port for StreamPort<'_> {
         Ok(Got::Bytes(n))
     }
 
-    fn write(&mut self, bytes: &[u8]) -> Result<bool, ServeError> {
+    fn write(&mut self, bytes: &[u8]) -> Result<bool, PortError> {
         Ok(self
             .to
             .write_all(bytes)

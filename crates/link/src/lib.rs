@@ -1,23 +1,38 @@
-//! Transports to the device under test behind one trait: the built-in simulator, a serial
-//! port, a TCP byte stream and a subprocess on stdin/stdout.
+//! Byte-stream transports with time-outs: all the operating-system I/O of drivespec.
+//!
+//! - [`Link`]: the runner's side of a device under test, one trait for a serial port
+//!   ([`SerialLink`]), a TCP byte stream ([`TcpLink`]) and a subprocess on stdin/stdout
+//!   ([`ExecLink`]); an in-process model implements it too (`drivespec-sim`).
+//! - [`port`]: the served side, one client's byte stream ([`port::Port`]): a TCP client, a
+//!   reader and writer pair, or the master of a pseudo-terminal ([`Pty`], Unix).
 //!
 //! Every call is bounded in time: `recv` returns at its deadline whatever came, writes time
 //! out, and nothing waits on a peer without a limit. A peer that misbehaves (garbage, partial
 //! frames, a closed connection, a process that hangs or dies) gives an error or unexpected
 //! bytes, never a hang or a panic; `recover` reconnects or restarts it.
 //!
-//! Time: each link has a clock in µs from when it was opened. For `sim` the clock is virtual
-//! and only moves when the runner waits, so a whole suite runs in milliseconds and always
-//! gives the same result; the others use the monotonic wall clock.
+//! Time: each link has a clock in µs from when it was opened. The links here use the
+//! monotonic wall clock ([`WallClock`]); an in-process model's clock is virtual and only moves
+//! when the runner waits.
+//!
+//! Nothing here panics. Memory is bounded by what a peer sends before a deadline; every
+//! buffer a peer fills is read in bounded slices.
+#![forbid(unsafe_code)]
 
 mod exec;
+pub mod port;
+#[cfg(unix)]
+mod pty;
+mod quote;
 mod serial;
-mod sim;
 mod tcp;
 
 pub use exec::ExecLink;
+pub use port::PortError;
+#[cfg(unix)]
+pub use pty::{Pty, PtyPort};
+pub use quote::shell_quote;
 pub use serial::SerialLink;
-pub use sim::{SimDevice, SimLink};
 pub use tcp::TcpLink;
 
 /// Time in µs on a link's clock.
@@ -141,14 +156,16 @@ pub fn concat(chunks: &[Chunk]) -> Vec<u8> {
 
 /// A monotonic clock in µs from its creation.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct WallClock(std::time::Instant);
+pub struct WallClock(std::time::Instant);
 
 impl WallClock {
-    pub(crate) fn start() -> WallClock {
+    /// A clock at 0 now.
+    pub fn start() -> WallClock {
         WallClock(std::time::Instant::now())
     }
 
-    pub(crate) fn now(&self) -> Micros {
+    /// µs since [`WallClock::start`].
+    pub fn now(&self) -> Micros {
         u64::try_from(self.0.elapsed().as_micros()).unwrap_or(u64::MAX)
     }
 

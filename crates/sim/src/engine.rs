@@ -3,9 +3,9 @@
 
 use super::device::{Emitted, ServedDevice};
 use super::faults::{Dice, Faults};
-use super::port::{Got, Port};
 use super::ServeError;
-use crate::link::{Micros, WallClock};
+use drivespec_link::port::{Got, Port};
+use drivespec_link::{Micros, WallClock};
 use drivespec_spec::hex::to_hex;
 use std::collections::VecDeque;
 use std::io::Write;

@@ -4,11 +4,10 @@
 
 use super::server::Server;
 use super::wire::{Reply, Request};
-use crate::link::{Link, LinkError, Micros};
+use drivespec_link::{Link, LinkError, Micros};
 
-/// Why a request got no usable reply.
+/// Why a request got no usable reply (a closed set: the fuzzer classifies every kind).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[non_exhaustive]
 pub enum PeerError {
     /// The transport failed.
     #[error(transparent)]

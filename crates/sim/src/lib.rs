@@ -1,13 +1,18 @@
 //! `drivespec sim`: a family's reference model served in real time on a byte stream, so
-//! masters and PLC drivers can be developed and tested against it.
+//! masters and PLC drivers can be developed and tested against it; and the same models
+//! in-process on virtual time, as the `sim` device under test of a conformance run.
 //!
 //! - [`mod@device`]: the served model behind [`ServedDevice`] (HPD's reference [`Drive`]).
 //! - PSD4xx and PSx3xx speak the cyclic-exchange protocol instead: [`with_cyclic_server`] and
-//!   [`serve_cyclic_tcp`], [`serve_cyclic_stream`], `serve_cyclic_pty` (module `cyclic`).
-//! - Transports: [`serve_tcp`] (one client at a time), [`serve_pty`] on a [`Pty`] (Unix: a
-//!   pseudo-terminal whose path any serial library opens) and [`serve_stream`]/[`serve_stdio`].
+//!   [`serve_cyclic_tcp`], [`serve_cyclic_stream`], `serve_cyclic_pty` (module `cyclic`), on
+//!   the server [`reference`] builds from the spec and the family's model crate.
+//! - Transports (from `drivespec-link`): [`serve_tcp`] (one client at a time), [`serve_pty`]
+//!   on a [`Pty`] (Unix: a pseudo-terminal whose path any serial library opens) and
+//!   [`serve_stream`]/[`serve_stdio`].
 //! - [`Faults`]: seeded fault injection for a client's error handling: answers dropped,
-//!   checksums corrupted, answers delayed.
+//!   checksums corrupted, answers delayed (decisions drawn from [`rng::Rng`]).
+//! - [`SimLink`]: a model on virtual time behind [`drivespec_link::Link`], the runner's
+//!   `--dut sim` for HPD.
 //!
 //! Time: the wall clock drives the model's virtual clock at the edge. A byte read at wall
 //! time `t` (µs since serving started) is handed to the model at `t`; the model is advanced to
@@ -18,17 +23,19 @@
 //! On a pseudo-terminal the bit rate the client set is checked against the drive's (Pr26 in
 //! force): bytes sent at another rate are refused, as a real line would garble them.
 //!
-//! Nothing here panics; memory is bounded by the model and the answers waiting for their time.
+//! Nothing here panics; memory is bounded by the model, the answers waiting for their time
+//! and one request line (64 KiB) per client.
 //!
 //! [`Drive`]: drivespec_hpd::model::Drive
+#![forbid(unsafe_code)]
 
 mod cyclic;
 pub mod device;
 mod engine;
 mod faults;
-pub(crate) mod port;
-#[cfg(unix)]
-mod pty;
+mod link;
+pub mod reference;
+pub mod rng;
 
 #[cfg(unix)]
 pub use cyclic::serve_cyclic_pty;
@@ -36,12 +43,13 @@ pub use cyclic::{serve_cyclic_stdio, serve_cyclic_stream, serve_cyclic_tcp, with
 pub use device::{device, DeviceOptions, Emitted, HpdDevice, ServedDevice};
 pub use engine::{Options, Stats, Stop};
 pub use faults::Faults;
-#[cfg(unix)]
-pub use pty::Pty;
+pub use link::{SimDevice, SimLink};
 
+#[cfg(unix)]
+pub use drivespec_link::Pty;
+use drivespec_link::{port::StreamPort, port::TcpPort, PortError};
 use drivespec_spec::FamilyId;
 use engine::{End, Engine};
-use port::{StreamPort, TcpPort};
 use std::io::{Read, Write};
 use std::net::TcpListener;
 use std::time::Duration;
@@ -78,6 +86,29 @@ pub enum ServeError {
         /// The error.
         reason: String,
     },
+}
+
+impl From<reference::ReferenceError> for ServeError {
+    fn from(e: reference::ReferenceError) -> ServeError {
+        match e {
+            reference::ReferenceError::UnknownModel { .. } => ServeError::Usage(e.to_string()),
+            other => ServeError::Model(other.to_string()),
+        }
+    }
+}
+
+impl From<PortError> for ServeError {
+    fn from(e: PortError) -> ServeError {
+        match e {
+            PortError::Open { what, reason } => ServeError::Open { what, reason },
+            PortError::Io { what, reason } => ServeError::Io { what, reason },
+            // A kind of failure added later: its text, as an i/o failure of the port.
+            other => ServeError::Io {
+                what: "port",
+                reason: other.to_string(),
+            },
+        }
+    }
 }
 
 /// How long the accept loop sleeps when no client is waiting.

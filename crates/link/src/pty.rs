@@ -5,11 +5,10 @@
 //! The slave starts in raw mode at the drive's bit rate. The device keeps its own descriptor
 //! of the slave open, so clients can open and close the path any number of times and the
 //! master never sees a hang-up. The client's termios settings are visible from the master:
-//! the bit rate it set is checked against the drive's (see [`super`]). A pseudo-terminal
+//! the bit rate it set is checked against the drive's (see `drivespec-sim`). A pseudo-terminal
 //! moves bytes at memory speed whatever bit rate is set: there is no line time.
 
-use super::port::{readable, Got, Port};
-use super::ServeError;
+use crate::port::{readable, Got, Port, PortError};
 use rustix::fd::OwnedFd;
 use rustix::fs::{Mode, OFlags};
 use rustix::io::Errno;
@@ -28,8 +27,8 @@ pub struct Pty {
 
 impl Pty {
     /// Creates a pseudo-terminal, its slave in raw mode at `bit_rate` when given.
-    pub fn open(bit_rate: Option<u32>) -> Result<Pty, ServeError> {
-        let fail = |step: &str, e: Errno| ServeError::Open {
+    pub fn open(bit_rate: Option<u32>) -> Result<Pty, PortError> {
+        let fail = |step: &str, e: Errno| PortError::Open {
             what: "a pseudo-terminal".to_owned(),
             reason: format!("{step}: {e}"),
         };
@@ -72,18 +71,19 @@ impl Pty {
         tcgetattr(&self.master).ok().map(|t| t.output_speed())
     }
 
-    pub(crate) fn port(&self) -> Result<PtyPort<'_>, ServeError> {
+    /// The master side as a port for one served stream.
+    pub fn port(&self) -> Result<PtyPort<'_>, PortError> {
         Ok(PtyPort { pty: self })
     }
 }
 
 /// The master side of a [`Pty`] as a port.
-pub(crate) struct PtyPort<'p> {
+pub struct PtyPort<'p> {
     pty: &'p Pty,
 }
 
 impl Port for PtyPort<'_> {
-    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, ServeError> {
+    fn read(&mut self, buf: &mut [u8], wait: Duration) -> Result<Got, PortError> {
         if !readable(&self.pty.master, wait, "pseudo-terminal")? {
             return Ok(Got::Idle);
         }
@@ -96,14 +96,14 @@ impl Port for PtyPort<'_> {
                 std::thread::sleep(wait);
                 Ok(Got::Idle)
             }
-            Err(e) => Err(ServeError::Io {
+            Err(e) => Err(PortError::Io {
                 what: "pseudo-terminal",
                 reason: e.to_string(),
             }),
         }
     }
 
-    fn write(&mut self, bytes: &[u8]) -> Result<bool, ServeError> {
+    fn write(&mut self, bytes: &[u8]) -> Result<bool, PortError> {
         let mut rest = bytes;
         while !rest.is_empty() {
             match rustix::io::write(&self.pty.master, rest) {
@@ -113,7 +113,7 @@ impl Port for PtyPort<'_> {
                 // lost, as on a line nobody listens to.
                 Err(Errno::AGAIN) => return Ok(true),
                 Err(e) => {
-                    return Err(ServeError::Io {
+                    return Err(PortError::Io {
                         what: "pseudo-terminal",
                         reason: e.to_string(),
                     })

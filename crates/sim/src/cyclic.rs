@@ -1,5 +1,5 @@
 //! `drivespec sim psd4xx|psx3xx`: a reference model served on the cyclic-exchange protocol
-//! `drivespec-cyclic/1` (crates/conform/README.md, "Cyclic-exchange protocol").
+//! `drivespec-cyclic/1` (crates/cyclic/README.md).
 //!
 //! Any [`Server`] is served, so every family with a cyclic server joins by naming it in
 //! [`with_cyclic_server`]. Each TCP connection, the pseudo-terminal and the stdio stream are one
@@ -14,14 +14,12 @@
 
 use super::engine::{Options, Stats, Stop};
 use super::faults::Dice;
-use super::port::{Got, Port, StreamPort, TcpPort};
 use super::ServeError;
-use crate::cyclic::wire::hex;
-use crate::cyclic::{Reply, Server};
-use crate::link::{Micros, WallClock};
-use crate::psd4xx::Psd4xxSuite;
-use crate::psx3xx::Psx3xxSuite;
-use crate::suite::Settings;
+use crate::reference;
+use drivespec_cyclic::wire::hex;
+use drivespec_cyclic::{Reply, Server};
+use drivespec_link::port::{Got, Port, StreamPort, TcpPort};
+use drivespec_link::{Micros, WallClock};
 use drivespec_spec::{FamilyId, Spec};
 use std::cell::RefCell;
 use std::io::{BufReader, ErrorKind, Read, Write};
@@ -46,22 +44,16 @@ pub fn with_cyclic_server<R>(
     model: Option<&str>,
     f: impl FnOnce(&mut Server<'_>, &str) -> R,
 ) -> Result<R, ServeError> {
-    let settings = Settings {
-        model: model.map(str::to_owned),
-        ..Settings::default()
-    };
     match family {
         FamilyId::Psd4xx => {
-            let suite =
-                Psd4xxSuite::new(spec, &settings).map_err(|e| ServeError::Usage(e.to_string()))?;
-            let name = format!("psd4xx reference {}", suite.model());
-            Ok(f(&mut suite.server(), &name))
+            let r = reference::psd4xx(spec, model)?;
+            let name = format!("psd4xx reference {}", r.model.id);
+            Ok(f(&mut r.server(family), &name))
         }
         FamilyId::Psx3xx => {
-            let suite =
-                Psx3xxSuite::new(spec, &settings).map_err(|e| ServeError::Usage(e.to_string()))?;
-            let name = format!("psx3xx reference {}", suite.model());
-            Ok(f(&mut suite.server(), &name))
+            let r = reference::psx3xx(spec, model)?;
+            let name = format!("psx3xx reference {}", r.model.id);
+            Ok(f(&mut r.server(family), &name))
         }
         other => Err(ServeError::NotAvailable { family: other }),
     }
@@ -351,7 +343,7 @@ pub fn serve_cyclic_tcp(
 /// Serves `server` on the pseudo-terminal `pty` (line protocol on the terminal) until stopped.
 #[cfg(unix)]
 pub fn serve_cyclic_pty(
-    pty: &super::Pty,
+    pty: &drivespec_link::Pty,
     server: &mut Server<'_>,
     opts: &Options,
     stop: &Stop,
@@ -401,7 +393,7 @@ fn stamp(t: Micros) -> String {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
-    use crate::serve::Faults;
+    use crate::Faults;
 
     fn run(input: &str, faults: Faults) -> (Vec<String>, Stats) {
         let spec = Spec::builtin().unwrap();

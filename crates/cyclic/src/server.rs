@@ -326,15 +326,35 @@ fn record_reply(r: Option<Result<RecordAnswer, RecordFailure>>) -> Reply {
 
 #[cfg(test)]
 mod tests {
-    use crate::suite::Settings;
-    use drivespec_spec::Spec;
+    use super::Server;
+    use drivespec_spec::{FamilyId, Spec};
+
+    fn psx3xx(spec: &Spec) -> Server<'_> {
+        let config = drivespec_psx3xx::model::DriveConfig::new("PSE312-8");
+        let drive =
+            drivespec_psx3xx::model::Drive::new(spec, config).unwrap_or_else(|e| panic!("{e}"));
+        Server::new(
+            "drivespec reference PSE312-8",
+            FamilyId::Psx3xx.as_str(),
+            Box::new(drive),
+        )
+    }
+
+    fn psd4xx(spec: &Spec) -> Server<'static> {
+        let config = drivespec_psd4xx::model::DriveConfig::new("PSD401-5V");
+        let drive =
+            drivespec_psd4xx::model::Drive::new(spec, config).unwrap_or_else(|e| panic!("{e}"));
+        Server::new(
+            "drivespec reference PSD401-5V",
+            FamilyId::Psd4xx.as_str(),
+            Box::new(drive),
+        )
+    }
 
     #[test]
     fn a_psx3xx_server_answers_isdu_and_refuses_records() {
         let spec = Spec::builtin().unwrap_or_else(|e| panic!("{e:?}"));
-        let suite = crate::psx3xx::Psx3xxSuite::new(&spec, &Settings::default())
-            .unwrap_or_else(|e| panic!("{e}"));
-        let mut s = suite.server();
+        let mut s = psx3xx(&spec);
         let mut ask = |line: &str| s.handle_line(line);
         assert_eq!(
             ask("HELLO drivespec-cyclic 1 psx3xx PSE312-8"),
@@ -363,9 +383,7 @@ mod tests {
     #[test]
     fn a_psd4xx_server_refuses_isdu_and_keys() {
         let spec = Spec::builtin().unwrap_or_else(|e| panic!("{e:?}"));
-        let suite = crate::psd4xx::Psd4xxSuite::new(&spec, &Settings::default())
-            .unwrap_or_else(|e| panic!("{e}"));
-        let mut s = suite.server();
+        let mut s = psd4xx(&spec);
         assert_eq!(s.handle_line("RESET"), "OK");
         assert!(s.handle_line("ISDU-READ 0 116 0").starts_with("ERR"));
         assert_eq!(s.handle_line("ENV 0 keys both"), "UNSUPPORTED");
@@ -376,9 +394,7 @@ mod tests {
     #[test]
     fn a_time_jump_beyond_the_bound_is_refused_not_simulated() {
         let spec = Spec::builtin().unwrap_or_else(|e| panic!("{e:?}"));
-        let suite = crate::psd4xx::Psd4xxSuite::new(&spec, &Settings::default())
-            .unwrap_or_else(|e| panic!("{e}"));
-        let mut s = suite.server();
+        let mut s = psd4xx(&spec);
         assert_eq!(s.handle_line("RESET"), "OK");
         assert!(s
             .handle_line("ADVANCE 18446744073709551615")

@@ -1,4 +1,4 @@
-//! Request and reply lines of `drivespec-cyclic/1` (README "Cyclic-exchange protocol"): the
+//! Request and reply lines of `drivespec-cyclic/1` (README "Protocol"): the
 //! PSD4xx records (`READ`/`WRITE`) and the PSx3xx ISDU requests (`ISDU-READ`/`ISDU-WRITE`).
 //!
 //! Words are separated by single blanks; numbers are decimal (times in µs, signed values with

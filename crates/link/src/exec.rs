@@ -178,11 +178,7 @@ fn writer(mut stdin: ChildStdin, rx: Receiver<Vec<u8>>) {
 
 impl Link for ExecLink {
     fn describe(&self) -> String {
-        let words: Vec<String> = self
-            .argv
-            .iter()
-            .map(|w| crate::dut::shell_quote(w))
-            .collect();
+        let words: Vec<String> = self.argv.iter().map(|w| crate::shell_quote(w)).collect();
         format!("exec:{}", words.join(" "))
     }
 

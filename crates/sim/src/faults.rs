@@ -2,8 +2,8 @@
 //! `--delay-ms`, `--seed`): the same seed and the same traffic always give the same faults.
 
 use super::ServeError;
-use crate::link::Micros;
 use crate::rng::Rng;
+use drivespec_link::Micros;
 
 /// Faults applied to what the device sends.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

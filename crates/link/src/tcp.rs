@@ -102,7 +102,7 @@ impl Link for TcpLink {
                 } else {
                     left
                 };
-                let ready = crate::serve::port::readable(&*s, wait, "tcp")
+                let ready = crate::port::readable(&*s, wait, "tcp")
                     .map_err(|e| LinkError::Io(e.to_string()))?;
                 if !ready {
                     continue;

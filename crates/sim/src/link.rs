@@ -1,7 +1,7 @@
 //! `sim`: a device model on virtual time as the device under test.
 
-use super::{Caps, Chunk, Link, LinkError, Micros, Recovered};
 use drivespec_hpd::model::{Drive, Output};
+use drivespec_link::{Caps, Chunk, Link, LinkError, Micros, Recovered};
 
 /// A sans-IO device model the simulator link drives (the HPD reference [`Drive`], or a
 /// wrapper around it with a planted deviation, for mutation tests).

@@ -2,11 +2,11 @@
 //! PSD4xx and PSx3xx models can join once their cyclic-exchange protocol exists.
 
 use super::ServeError;
-use crate::link::Micros;
 use drivespec_hpd::explain::explain;
 use drivespec_hpd::model::{Drive, DriveConfig, ModelError, Output};
 use drivespec_hpd::plc::PlcCodec;
 use drivespec_hpd::{FrameRules, LineDecoder, LineEvent, Message};
+use drivespec_link::Micros;
 use drivespec_spec::{FamilyId, Spec};
 use std::sync::Arc;
 

@@ -1,18 +1,19 @@
-//! A small seeded generator (SplitMix64) for the values cases pick: the same `--seed` always
-//! gives the same cases, so a failure replays exactly.
+//! A small seeded generator (SplitMix64) for the fault decisions here and the values
+//! conformance cases and fuzz inputs pick: the same seed always gives the same values, so a
+//! failure replays exactly.
 
 /// SplitMix64 (Steele, Lea, Flood 2014): fast, seedable, good enough for test values.
 #[derive(Debug, Clone)]
-pub(crate) struct Rng(u64);
+pub struct Rng(u64);
 
 impl Rng {
     /// A generator for `seed`.
-    pub(crate) fn new(seed: u64) -> Rng {
+    pub fn new(seed: u64) -> Rng {
         Rng(seed ^ 0x5DEE_CE66_D1CE_4E5B)
     }
 
     /// The next 64 random bits.
-    pub(crate) fn next_u64(&mut self) -> u64 {
+    pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -21,7 +22,7 @@ impl Rng {
     }
 
     /// A value in `lo..=hi` (`lo` when the interval is empty).
-    pub(crate) fn range(&mut self, lo: i64, hi: i64) -> i64 {
+    pub fn range(&mut self, lo: i64, hi: i64) -> i64 {
         if hi <= lo {
             return lo;
         }
@@ -31,7 +32,7 @@ impl Rng {
     }
 
     /// A byte.
-    pub(crate) fn byte(&mut self) -> u8 {
+    pub fn byte(&mut self) -> u8 {
         self.next_u64().to_le_bytes().first().copied().unwrap_or(0)
     }
 }
