@@ -9,7 +9,8 @@
 //! by [`Reassembler`] within limits on the message size, the fragments per message and the
 //! calls pending at once (the oldest is dropped and counted). Parsing never panics.
 
-use crate::bytes::{hex, Endian, Reader, Truncated};
+use crate::bytes::{Endian, Reader, Truncated};
+use drivespec_spec::hex::to_hex_lower;
 use std::collections::{BTreeMap, VecDeque};
 use std::fmt;
 
@@ -76,7 +77,7 @@ impl Uuid {
 
 impl fmt::Display for Uuid {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let h = hex(&self.0);
+        let h = to_hex_lower(&self.0);
         let part = |a: usize, b: usize| h.get(a..b).unwrap_or("");
         write!(
             f,

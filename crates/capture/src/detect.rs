@@ -6,7 +6,8 @@
 //!
 //! Detection never fails: it always names a format and says what it saw.
 
-use crate::bytes::{hex, Endian};
+use crate::bytes::Endian;
+use drivespec_spec::hex::to_hex_lower;
 use std::fmt;
 
 /// A recording format (our doc: module `detect`).
@@ -94,7 +95,7 @@ impl fmt::Display for Detection {
             if self.gzip { "gzip-compressed " } else { "" },
             self.format,
             self.reason,
-            hex(&self.head)
+            to_hex_lower(&self.head)
         )
     }
 }
@@ -150,7 +151,7 @@ fn classify(prefix: &[u8]) -> (Format, String) {
                     },
                     format!(
                         "pcapng section header 0a0d0d0a, byte-order magic {} not recognised",
-                        hex(other.unwrap_or(&[]))
+                        to_hex_lower(other.unwrap_or(&[]))
                     ),
                 ),
             };

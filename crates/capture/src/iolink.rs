@@ -17,10 +17,10 @@
 //! errors. Errors name the line; a bad line is reported and reading goes on with the next one.
 //! Lines are limited to [`MAX_LINE`] bytes. Nothing here panics.
 
-use crate::bytes::parse_hex;
 use crate::detect::Format;
 use crate::input::{Input, LineError, Lines, ReadError};
 use crate::time::{parse_time_field, Micros};
+use drivespec_spec::hex::{parse_hex, parse_int};
 use serde::Deserialize;
 use std::io::Read;
 
@@ -228,11 +228,7 @@ impl Check {
             Some(Value::Num(n)) => n,
             Some(Value::Str(s)) => {
                 let s = s.trim();
-                let parsed = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
-                    Some(h) => u64::from_str_radix(h, 16),
-                    None => s.parse(),
-                };
-                parsed.map_err(|_| self.err(field, format!("`{s}` is not a number")))?
+                parse_int(s).map_err(|_| self.err(field, format!("`{s}` is not a number")))?
             }
         };
         if n > max {
@@ -243,11 +239,9 @@ impl Check {
 
     fn hex(&self, field: &'static str, v: Option<String>) -> Result<Option<Vec<u8>>, IoLinkError> {
         let Some(s) = v else { return Ok(None) };
-        let t = s.trim();
-        let t = t.strip_prefix("0x").unwrap_or(t);
-        parse_hex(t)
+        parse_hex(s.trim())
             .map(Some)
-            .ok_or_else(|| self.err(field, format!("`{s}` is not hex bytes")))
+            .map_err(|_| self.err(field, format!("`{s}` is not hex bytes")))
     }
 
     fn absent(&self, kind: &str, field: &'static str, present: bool) -> Result<(), IoLinkError> {

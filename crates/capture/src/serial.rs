@@ -33,12 +33,12 @@
 //! Text lines are limited to [`MAX_LINE`] bytes and socat chunks to [`MAX_SOCAT_CHUNK`]; a
 //! line error is reported and reading goes on with the next line. I/O and capture errors end the stream. Nothing here panics.
 
-use crate::bytes::{hex_val, parse_hex};
 use crate::detect::Format;
 use crate::input::{Input, Line, LineError, Lines, ReadError};
 use crate::link::LinkType;
 use crate::pcap::{CaptureError, CaptureReader, Options};
 use crate::time::{parse_iso, parse_socat, Micros};
+use drivespec_spec::hex::{hex_digit, parse_hex};
 use std::io::Read;
 
 /// Bytes per chunk of a raw recording.
@@ -182,7 +182,7 @@ fn parse_socat_hex(line: &str, want: usize) -> Result<Vec<u8>, String> {
     for i in 0..want.min(16) {
         let at = 3 * i;
         match (bytes.get(at), bytes.get(at + 1), bytes.get(at + 2)) {
-            (Some(b' '), Some(&h), Some(&l)) => match (hex_val(h), hex_val(l)) {
+            (Some(b' '), Some(&h), Some(&l)) => match (hex_digit(h), hex_digit(l)) {
                 (Some(h), Some(l)) => out.push(h << 4 | l),
                 _ => break,
             },
@@ -226,7 +226,7 @@ pub(crate) fn parse_text_line(line: &str) -> Result<TextLine, &'static str> {
         "-" => None,
         _ => return Err("direction must be >, < or -"),
     };
-    let bytes = parse_hex(hex_text.trim()).ok_or("bytes must be hex digit pairs")?;
+    let bytes = parse_hex(hex_text.trim()).map_err(|_| "bytes must be hex digit pairs")?;
     if bytes.is_empty() {
         return Err("no bytes");
     }

@@ -14,12 +14,13 @@
 
 use crate::error::SetupError;
 use crate::report::{
-    hex, Catalog, DriveInfo, Evidence, InputFault, Recorder, Report, Stats, StreamStats, Where,
+    Catalog, DriveInfo, Evidence, InputFault, Recorder, Report, Stats, StreamStats, Where,
 };
 use crate::timeline::{Sample, Timeline};
 use drivespec_capture::iolink::{Access, IoLinkError, IoLinkEvent, IoLinkKind, IsduResult};
 use drivespec_psx3xx::isdu::{ErrorCase, ErrorType, Request, Value};
 use drivespec_psx3xx::{ByteOrder, Guards, Input, Output, Rules, StampMeaning, WriteFate};
+use drivespec_spec::hex::to_hex;
 use drivespec_spec::psx3xx::RunAction;
 use drivespec_spec::{DeviceModel, FamilyId, Readings, Spec};
 use std::collections::BTreeMap;
@@ -667,7 +668,7 @@ impl<'s> IoLinkChecker<'s> {
             .with(
                 "response",
                 match result {
-                    IsduResult::Data(d) => format!("data {}", hex(d)),
+                    IsduResult::Data(d) => format!("data {}", to_hex(d)),
                     IsduResult::Error(e) => format!("error {e:#06x}"),
                 },
             );

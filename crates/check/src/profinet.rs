@@ -28,6 +28,7 @@ use drivespec_capture::profinet::{Counts, MalformedError, Pdu, PduError, PnEvent
 use drivespec_capture::rt::{ApduStatus, FrameClass, RtError};
 use drivespec_psd4xx::model::{Drive, DriveConfig};
 use drivespec_psd4xx::{Input, Output, Rules};
+use drivespec_spec::hex::{encode, Case};
 use drivespec_spec::{FamilyId, Spec};
 use serde_json::json;
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -239,10 +240,7 @@ impl std::hash::BuildHasher for BuildFx {
 }
 
 fn mac(m: &[u8; 6]) -> String {
-    m.iter()
-        .map(|b| format!("{b:02x}"))
-        .collect::<Vec<_>>()
-        .join(":")
+    encode(m, Case::Lower, ":")
 }
 
 impl<'s> PnChecker<'s> {

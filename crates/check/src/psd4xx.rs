@@ -15,7 +15,7 @@
 //! expected back on later reads, except for `live` parameters. Memory is bounded by the
 //! parameter table. Nothing here panics.
 
-use crate::report::{hex, Evidence, Recorder, Where};
+use crate::report::{Evidence, Recorder, Where};
 use crate::timeline::{Sample, Timeline};
 use drivespec_psd4xx::model::Drive;
 use drivespec_psd4xx::pkw::PkwRules;
@@ -23,6 +23,7 @@ use drivespec_psd4xx::{
     CommandCode, ErrorCode, Input, Output, PkwRequest, PkwResponse, RecordShape, Rules, Verdict,
     Width,
 };
+use drivespec_spec::hex::to_hex;
 use drivespec_spec::psd4xx::{PkwOp, PkwValue};
 use drivespec_spec::{DeviceModel, Family};
 use std::collections::BTreeMap;
@@ -1053,7 +1054,7 @@ impl<'s> PsdDrive<'s> {
                 ),
                 Evidence::bytes(data)
                     .with("index", index)
-                    .with("data", hex(data)),
+                    .with("data", to_hex(data)),
             );
             return;
         }

@@ -7,6 +7,7 @@
 //! by [`crate::timeline::MAX_SAMPLES`]. Nothing here panics.
 
 use crate::timeline::Timeline;
+use drivespec_spec::hex::to_hex;
 use drivespec_spec::{Requirement, Spec};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
@@ -112,7 +113,7 @@ impl Evidence {
     /// Evidence of the bytes `b`.
     pub fn bytes(b: &[u8]) -> Evidence {
         Evidence {
-            bytes: Some(hex(b)),
+            bytes: Some(to_hex(b)),
             fields: BTreeMap::new(),
         }
     }
@@ -127,18 +128,6 @@ impl Evidence {
         self.fields.insert(name.to_owned(), value.into());
         self
     }
-}
-
-/// Hex of bytes, upper case, blank-separated (the spec's hex form).
-pub fn hex(b: &[u8]) -> String {
-    let mut s = String::with_capacity(b.len() * 3);
-    for (i, x) in b.iter().enumerate() {
-        if i > 0 {
-            s.push(' ');
-        }
-        s.push_str(&format!("{x:02X}"));
-    }
-    s
 }
 
 /// One violation of a requirement.

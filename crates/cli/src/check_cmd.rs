@@ -6,6 +6,7 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use drivespec_check::profinet::Manual;
 use drivespec_check::run::{check_path, Device, InputFormat, Progress, RunOptions};
 use drivespec_check::{render, Report};
+use drivespec_spec::hex::parse_int;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
@@ -98,11 +99,7 @@ pub enum ReportArg {
 
 fn number(text: &str) -> Result<u64> {
     let t = text.trim();
-    let v = match t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
-        Some(h) => u64::from_str_radix(h, 16),
-        None => t.parse(),
-    };
-    v.map_err(|_| anyhow!("{t:?} is not a number (decimal or 0x hex)"))
+    parse_int(t).map_err(|_| anyhow!("{t:?} is not a number (decimal or 0x hex)"))
 }
 
 fn pair(text: &str, what: &str) -> Result<(u64, u64)> {

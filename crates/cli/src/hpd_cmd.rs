@@ -7,7 +7,7 @@ use drivespec_hpd::explain::{explain, Explained};
 use drivespec_hpd::params::Target;
 use drivespec_hpd::plc::{PlcCodec, Program};
 use drivespec_hpd::{Data, Exchange, FrameRules, LineDecoder, LineEvent, Message, Pairer};
-use drivespec_spec::hex::{parse_hex, to_hex};
+use drivespec_spec::hex::{parse_hex, parse_int, to_hex};
 use drivespec_spec::{Family, FamilyId, Spec};
 use serde::Serialize;
 use std::io::Read as _;
@@ -315,11 +315,7 @@ enum EncodeWhat {
 }
 
 fn parse_u8(s: &str) -> std::result::Result<u8, String> {
-    let parsed = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
-        Some(h) => u8::from_str_radix(h, 16),
-        None => s.parse(),
-    };
-    parsed.map_err(|_| format!("{s:?} is not a byte (0…255 or 0x00…0xFF)"))
+    parse_int(s).map_err(|_| format!("{s:?} is not a byte (0…255 or 0x00…0xFF)"))
 }
 
 /// Runs `drivespec encode hpd`.

@@ -4,7 +4,7 @@ use crate::{json, Context, Format, Outcome};
 use anyhow::{anyhow, Context as _, Result};
 use clap::Args;
 use drivespec_positioner::ByteOrder;
-use drivespec_spec::hex::{parse_hex, to_hex};
+use drivespec_spec::hex::{parse_hex, parse_int, to_hex};
 use drivespec_spec::FamilyId;
 use std::path::PathBuf;
 
@@ -64,14 +64,7 @@ pub struct Psd4xxEncode {
 
 /// A number in decimal or 0x hex.
 fn number(s: &str) -> std::result::Result<i64, String> {
-    let t = s.trim();
-    let (neg, t) = t.strip_prefix('-').map_or((false, t), |r| (true, r));
-    let v = match t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
-        Some(h) => i64::from_str_radix(h, 16),
-        None => t.parse(),
-    }
-    .map_err(|_| format!("{s:?} is not a number"))?;
-    Ok(if neg { -v } else { v })
+    parse_int(s).map_err(|_| format!("{s:?} is not a number"))
 }
 
 fn psd_rules(

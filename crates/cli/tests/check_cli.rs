@@ -7,8 +7,10 @@
     clippy::panic
 )]
 
+use drivespec_testkit::{run_with, CI};
 use std::path::PathBuf;
-use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
 fn capture(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -18,19 +20,6 @@ fn capture(name: &str) -> String {
         .to_string()
 }
 
-fn drivespec(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_drivespec"))
-        .args(args)
-        .env("CI", "true")
-        .output()
-        .expect("run drivespec");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn clean_recordings_of_every_family_exit_0_and_say_what_was_detected() {
     for (file, family, detected) in [
@@ -38,7 +27,7 @@ fn clean_recordings_of_every_family_exit_0_and_say_what_was_detected() {
         ("psd4xx-clean.pcap.gz", "[psd4xx]", "gzip-compressed pcap"),
         ("psx3xx-clean.csv", "[psx3xx]", "IO-Link CSV"),
     ] {
-        let (code, out, err) = drivespec(&["check", &capture(file)]);
+        let (code, out, err) = run_with(BIN, &["check", &capture(file)], None, CI);
         assert_eq!(code, 0, "{file}: {out}{err}");
         assert!(out.contains(family), "{out}");
         assert!(out.contains(detected), "{out}");
@@ -48,7 +37,12 @@ fn clean_recordings_of_every_family_exit_0_and_say_what_was_detected() {
 
 #[test]
 fn violations_exit_1_with_requirement_place_and_evidence() {
-    let (code, out, _) = drivespec(&["check", "--baud", "8", &capture("hpd-faults.txt")]);
+    let (code, out, _) = run_with(
+        BIN,
+        &["check", "--baud", "8", &capture("hpd-faults.txt")],
+        None,
+        CI,
+    );
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("HPD-SERIAL-012"), "{out}");
     assert!(out.contains("line "), "{out}");
@@ -58,14 +52,19 @@ fn violations_exit_1_with_requirement_place_and_evidence() {
 
 #[test]
 fn json_report_follows_the_schema_and_counts_beyond_the_listing_cap() {
-    let (code, out, _) = drivespec(&[
-        "check",
-        "--report",
-        "json",
-        "--max-violations",
-        "1",
-        &capture("psd4xx-faults.pcap.gz"),
-    ]);
+    let (code, out, _) = run_with(
+        BIN,
+        &[
+            "check",
+            "--report",
+            "json",
+            "--max-violations",
+            "1",
+            &capture("psd4xx-faults.pcap.gz"),
+        ],
+        None,
+        CI,
+    );
     assert_eq!(code, 1);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["schema"], "drivespec-check/1");
@@ -93,7 +92,12 @@ fn json_report_follows_the_schema_and_counts_beyond_the_listing_cap() {
 
 #[test]
 fn the_global_json_format_selects_the_json_report() {
-    let (code, out, _) = drivespec(&["--format", "json", "check", &capture("psx3xx-clean.jsonl")]);
+    let (code, out, _) = run_with(
+        BIN,
+        &["--format", "json", "check", &capture("psx3xx-clean.jsonl")],
+        None,
+        CI,
+    );
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["reports"][0]["family"], "psx3xx");
@@ -101,25 +105,35 @@ fn the_global_json_format_selects_the_json_report() {
 
 #[test]
 fn junit_and_html_reports_and_the_report_dir() {
-    let (code, out, _) = drivespec(&[
-        "check",
-        "--report",
-        "junit",
-        &capture("psx3xx-faults.jsonl"),
-    ]);
+    let (code, out, _) = run_with(
+        BIN,
+        &[
+            "check",
+            "--report",
+            "junit",
+            &capture("psx3xx-faults.jsonl"),
+        ],
+        None,
+        CI,
+    );
     assert_eq!(code, 1);
     assert!(out.starts_with("<?xml"), "{out}");
     assert!(out.contains("name=\"PSX-GUARD-126-SUPPRESS\""), "{out}");
     assert!(out.contains("<failure"), "{out}");
     let dir = std::env::temp_dir().join(format!("drivespec-check-cli-{}", std::process::id()));
-    let (code, out, _) = drivespec(&[
-        "check",
-        "--report",
-        "html",
-        "--report-dir",
-        dir.to_str().unwrap(),
-        &capture("psd4xx-clean.pcap.gz"),
-    ]);
+    let (code, out, _) = run_with(
+        BIN,
+        &[
+            "check",
+            "--report",
+            "html",
+            "--report-dir",
+            dir.to_str().unwrap(),
+            &capture("psd4xx-clean.pcap.gz"),
+        ],
+        None,
+        CI,
+    );
     assert_eq!(code, 0);
     assert!(
         out.contains("<svg"),
@@ -133,7 +147,12 @@ fn junit_and_html_reports_and_the_report_dir() {
 
 #[test]
 fn a_truncated_capture_is_reported_up_to_the_error_and_exits_2() {
-    let (code, out, err) = drivespec(&["check", &capture("psd4xx-truncated.pcap.gz")]);
+    let (code, out, err) = run_with(
+        BIN,
+        &["check", &capture("psd4xx-truncated.pcap.gz")],
+        None,
+        CI,
+    );
     assert_eq!(code, 2, "{out}{err}");
     assert!(err.contains("truncated record at byte"), "{err}");
     assert!(
@@ -144,28 +163,43 @@ fn a_truncated_capture_is_reported_up_to_the_error_and_exits_2() {
 
 #[test]
 fn options_that_do_not_fit_the_recording_are_bad_usage() {
-    let (code, _, err) = drivespec(&["check", "--device", "psx3xx", &capture("hpd-clean.txt")]);
+    let (code, _, err) = run_with(
+        BIN,
+        &["check", "--device", "psx3xx", &capture("hpd-clean.txt")],
+        None,
+        CI,
+    );
     assert_eq!(code, 2);
     assert!(err.contains("--device psx3xx"), "{err}");
-    let (code, _, err) = drivespec(&["check", "--baud", "12345", &capture("hpd-clean.txt")]);
+    let (code, _, err) = run_with(
+        BIN,
+        &["check", "--baud", "12345", &capture("hpd-clean.txt")],
+        None,
+        CI,
+    );
     assert_eq!(code, 2);
     assert!(err.contains("--baud"), "{err}");
-    let (code, _, _) = drivespec(&["check", "/nonexistent/file.pcap"]);
+    let (code, _, _) = run_with(BIN, &["check", "/nonexistent/file.pcap"], None, CI);
     assert_eq!(code, 2);
-    let (code, _, _) = drivespec(&["check"]);
+    let (code, _, _) = run_with(BIN, &["check"], None, CI);
     assert_eq!(code, 2);
 }
 
 #[test]
 fn frame_id_and_offset_locate_the_drive_without_a_connect() {
-    let (code, out, _) = drivespec(&[
-        "check",
-        "--frame-id",
-        "0x8001,0x8000",
-        "--offset",
-        "0",
-        &capture("psd4xx-search.pcap.gz"),
-    ]);
+    let (code, out, _) = run_with(
+        BIN,
+        &[
+            "check",
+            "--frame-id",
+            "0x8001,0x8000",
+            "--offset",
+            "0",
+            &capture("psd4xx-search.pcap.gz"),
+        ],
+        None,
+        CI,
+    );
     assert_eq!(code, 1);
     assert!(out.contains("found by options"), "{out}");
     assert!(out.contains("PSD-STS-5-SET-1"), "{out}");

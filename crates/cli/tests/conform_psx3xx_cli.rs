@@ -8,24 +8,15 @@
     clippy::panic
 )]
 
-use std::path::PathBuf;
+use drivespec_testkit::temp_dir;
 use std::process::Command;
 
-fn bin() -> &'static str {
-    env!("CARGO_BIN_EXE_drivespec")
-}
-
-fn report_dir(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!(
-        "drivespec-conform-psx3xx-{name}-{}",
-        std::process::id()
-    ))
-}
+const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
 /// Runs `drivespec conform` with `args`; exit code, output and the JSON report.
 fn conform(name: &str, args: &[&str]) -> (i32, String, serde_json::Value) {
-    let dir = report_dir(name);
-    let out = Command::new(bin())
+    let dir = temp_dir("conform-psx3xx", name);
+    let out = Command::new(BIN)
         .arg("conform")
         .args(args)
         .args(["--quiet", "--report-dir"])
@@ -68,7 +59,7 @@ fn sim_with_a_model_suffix_passes() {
 
 #[test]
 fn exec_against_the_served_model_passes() {
-    let dut = format!("exec:{} sim psx3xx --stdio", bin());
+    let dut = format!("exec:{} sim psx3xx --stdio", BIN);
     let (code, out, json) = conform(
         "exec",
         &[
@@ -90,7 +81,7 @@ fn exec_against_the_served_model_passes() {
 
 #[test]
 fn all_lists_psx3xx_cases() {
-    let out = Command::new(bin())
+    let out = Command::new(BIN)
         .args(["conform", "all", "--list", "--case", "psx3xx/guard/*"])
         .output()
         .unwrap();

@@ -6,53 +6,45 @@
     clippy::panic
 )]
 
-use std::path::PathBuf;
-use std::process::Command;
+use drivespec_testkit::{run_with, temp_dir, CI};
 
-fn drivespec(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_drivespec"))
-        .args(args)
-        .env("CI", "true")
-        .output()
-        .expect("run drivespec");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("drivespec-fuzz-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
+const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
 #[test]
 fn bad_usage_is_refused() {
-    let (code, _, err) = drivespec(&["fuzz", "psx4xx"]);
+    let (code, _, err) = run_with(BIN, &["fuzz", "psx4xx"], None, CI);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("hpd, psd4xx or psx3xx"), "{err}");
-    let (code, _, _) = drivespec(&["fuzz", "hpd", "--iterations", "3", "--duration", "1s"]);
+    let (code, _, _) = run_with(
+        BIN,
+        &["fuzz", "hpd", "--iterations", "3", "--duration", "1s"],
+        None,
+        CI,
+    );
     assert_eq!(code, 2);
-    let (code, _, err) = drivespec(&["fuzz", "hpd", "--duration", "10 parsecs"]);
+    let (code, _, err) = run_with(BIN, &["fuzz", "hpd", "--duration", "10 parsecs"], None, CI);
     assert_eq!(code, 2, "{err}");
 }
 
 #[test]
 fn a_run_against_the_reference_passes_and_writes_reports() {
-    let out = temp("run");
+    let out = temp_dir("fuzz-cli", "run");
     let dir = out.display().to_string();
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "hpd",
-        "--iterations",
-        "30",
-        "--seed",
-        "5",
-        "--out",
-        &dir,
-    ]);
+    let (code, stdout, stderr) = run_with(
+        BIN,
+        &[
+            "fuzz",
+            "hpd",
+            "--iterations",
+            "30",
+            "--seed",
+            "5",
+            "--out",
+            &dir,
+        ],
+        None,
+        CI,
+    );
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(
         stdout.contains("30 sequence(s)") && stdout.contains("0 finding(s)"),
@@ -62,17 +54,22 @@ fn a_run_against_the_reference_passes_and_writes_reports() {
     for f in ["fuzz.json", "fuzz.junit.xml", "fuzz.html"] {
         assert!(out.join(f).is_file(), "{f}");
     }
-    let (code, stdout, _) = drivespec(&[
-        "--format",
-        "json",
-        "fuzz",
-        "hpd",
-        "--iterations",
-        "5",
-        "--out",
-        &dir,
-        "--quiet",
-    ]);
+    let (code, stdout, _) = run_with(
+        BIN,
+        &[
+            "--format",
+            "json",
+            "fuzz",
+            "hpd",
+            "--iterations",
+            "5",
+            "--out",
+            &dir,
+            "--quiet",
+        ],
+        None,
+        CI,
+    );
     assert_eq!(code, 0);
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(v["sequences"], 5);
@@ -100,19 +97,24 @@ const REPLAY: &str = r#"{
 
 #[test]
 fn replay_and_minimize_a_file() {
-    let out = temp("replay");
+    let out = temp_dir("fuzz-cli", "replay");
     std::fs::create_dir_all(&out).unwrap();
     let file = out.join("finding.json");
     std::fs::write(&file, REPLAY).unwrap();
     let f = file.display().to_string();
     let dir = out.display().to_string();
     // The reference answers correctly: the replay passes, and differs from the recording.
-    let (code, stdout, stderr) = drivespec(&["fuzz", "hpd", "--replay", &f]);
+    let (code, stdout, stderr) = run_with(BIN, &["fuzz", "hpd", "--replay", &f], None, CI);
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(stdout.contains("passes"), "{stdout}");
     assert!(stdout.contains("differs from the recorded one"), "{stdout}");
     assert!(stdout.contains("7E 20 02 C6 F4 01 DD"), "{stdout}");
-    let (code, stdout, _) = drivespec(&["fuzz", "hpd", "--minimize", &f, "--out", &dir]);
+    let (code, stdout, _) = run_with(
+        BIN,
+        &["fuzz", "hpd", "--minimize", &f, "--out", &dir],
+        None,
+        CI,
+    );
     assert_eq!(code, 0, "{stdout}");
     assert!(stdout.contains("nothing to minimise"), "{stdout}");
     // A broken file is unreadable input.
@@ -121,7 +123,7 @@ fn replay_and_minimize_a_file() {
         REPLAY.replace("\"do\": \"listen\"", "\"do\": \"nap\""),
     )
     .unwrap();
-    let (code, _, err) = drivespec(&["fuzz", "hpd", "--replay", &f]);
+    let (code, _, err) = run_with(BIN, &["fuzz", "hpd", "--replay", &f], None, CI);
     assert_eq!(code, 2);
     assert!(err.contains("step 1") && err.contains("nap"), "{err}");
     std::fs::remove_dir_all(&out).unwrap();

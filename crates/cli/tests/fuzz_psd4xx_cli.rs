@@ -9,48 +9,31 @@
     clippy::panic
 )]
 
+use drivespec_testkit::{run, temp_dir};
 use std::path::PathBuf;
 use std::process::Command;
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
-fn drivespec(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("run drivespec");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "drivespec-fuzz-psd-cli-{}-{name}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
 #[test]
 fn against_the_reference_nothing_is_found() {
-    let out = temp("sim");
+    let out = temp_dir("fuzz-psd-cli", "sim");
     let dir = out.display().to_string();
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "psd4xx",
-        "--model",
-        "PSD426",
-        "--iterations",
-        "40",
-        "--seed",
-        "3",
-        "--out",
-        &dir,
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "fuzz",
+            "psd4xx",
+            "--model",
+            "PSD426",
+            "--iterations",
+            "40",
+            "--seed",
+            "3",
+            "--out",
+            &dir,
+        ],
+    );
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(
         stdout.contains("40 sequence(s)") && stdout.contains("0 finding(s)"),
@@ -70,50 +53,56 @@ fn against_the_reference_nothing_is_found() {
 fn findings_against_the_example_adapter_replay_and_minimise() {
     let adapter = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/psd4xx_adapter.py");
     let dut = format!("exec:python3 {}", adapter.display());
-    let out = temp("exec");
+    let out = temp_dir("fuzz-psd-cli", "exec");
     let dir = out.display().to_string();
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "psd4xx",
-        "--dut",
-        &dut,
-        "--iterations",
-        "4",
-        "--max-findings",
-        "2",
-        "--minimize-runs",
-        "20",
-        "--out",
-        &dir,
-        "--quiet",
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "fuzz",
+            "psd4xx",
+            "--dut",
+            &dut,
+            "--iterations",
+            "4",
+            "--max-findings",
+            "2",
+            "--minimize-runs",
+            "20",
+            "--out",
+            &dir,
+            "--quiet",
+        ],
+    );
     assert_eq!(code, 1, "{stdout}{stderr}");
     assert!(stdout.contains("psd4xx/fuzz/finding-1: "), "{stdout}");
     let file = out.join("finding-1.json");
     let f = file.display().to_string();
-    let (code, stdout, stderr) = drivespec(&["fuzz", "psd4xx", "--dut", &dut, "--replay", &f]);
+    let (code, stdout, stderr) = run(BIN, &["fuzz", "psd4xx", "--dut", &dut, "--replay", &f]);
     assert_eq!(code, 1, "{stdout}{stderr}");
     assert!(
         !stdout.contains("differs from the recorded one"),
         "{stdout}"
     );
     // Against the built-in reference the same file passes.
-    let (code, stdout, _) = drivespec(&["fuzz", "psd4xx", "--replay", &f]);
+    let (code, stdout, _) = run(BIN, &["fuzz", "psd4xx", "--replay", &f]);
     assert_eq!(code, 0, "{stdout}");
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "psd4xx",
-        "--dut",
-        &dut,
-        "--minimize",
-        &f,
-        "--out",
-        &dir,
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "fuzz",
+            "psd4xx",
+            "--dut",
+            &dut,
+            "--minimize",
+            &f,
+            "--out",
+            &dir,
+        ],
+    );
     assert_eq!(code, 1, "{stdout}{stderr}");
     assert!(out.join("finding-1.min.json").is_file(), "{stdout}");
     // An HPD replay is refused for psd4xx.
-    let (code, _, stderr) = drivespec(&["fuzz", "hpd", "--replay", &f]);
+    let (code, _, stderr) = run(BIN, &["fuzz", "hpd", "--replay", &f]);
     assert_eq!(code, 2, "{stderr}");
     std::fs::remove_dir_all(&out).unwrap();
 }
@@ -139,21 +128,24 @@ fn over_tcp_against_drivespec_sim_nothing_is_found() {
     std::io::BufReader::new(sim.stdout.take().unwrap())
         .read_line(&mut addr)
         .unwrap();
-    let out = temp("tcp");
+    let out = temp_dir("fuzz-psd-cli", "tcp");
     let dut = format!("tcp:{}", addr.trim());
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "psd4xx",
-        "--dut",
-        &dut,
-        "--iterations",
-        "30",
-        "--seed",
-        "4",
-        "--quiet",
-        "--out",
-        &out.display().to_string(),
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "fuzz",
+            "psd4xx",
+            "--dut",
+            &dut,
+            "--iterations",
+            "30",
+            "--seed",
+            "4",
+            "--quiet",
+            "--out",
+            &out.display().to_string(),
+        ],
+    );
     let _ = sim.kill();
     let _ = sim.wait();
     assert_eq!(code, 0, "{stdout}{stderr}");

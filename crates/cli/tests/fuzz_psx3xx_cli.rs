@@ -11,31 +11,11 @@
     clippy::panic
 )]
 
+use drivespec_testkit::{run, temp_dir};
 use std::path::PathBuf;
 use std::process::Command;
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
-
-fn drivespec(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("run drivespec");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "drivespec-fuzz-psx-cli-{}-{name}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
 
 /// `exec:` running this binary's simulator on stdin/stdout.
 fn exec_sim() -> String {
@@ -44,18 +24,21 @@ fn exec_sim() -> String {
 
 #[test]
 fn against_the_reference_nothing_is_found() {
-    let out = temp("sim");
+    let out = temp_dir("fuzz-psx-cli", "sim");
     let dir = out.display().to_string();
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "psx3xx",
-        "--iterations",
-        "30",
-        "--seed",
-        "3",
-        "--out",
-        &dir,
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "fuzz",
+            "psx3xx",
+            "--iterations",
+            "30",
+            "--seed",
+            "3",
+            "--out",
+            &dir,
+        ],
+    );
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(
         stdout.contains("30 sequence(s)") && stdout.contains("0 finding(s)"),
@@ -73,21 +56,24 @@ fn against_the_reference_nothing_is_found() {
 
 #[test]
 fn over_exec_against_drivespec_sim_nothing_is_found() {
-    let out = temp("exec");
+    let out = temp_dir("fuzz-psx-cli", "exec");
     let dut = exec_sim();
-    let (code, stdout, stderr) = drivespec(&[
-        "fuzz",
-        "psx3xx",
-        "--dut",
-        &dut,
-        "--iterations",
-        "15",
-        "--seed",
-        "4",
-        "--quiet",
-        "--out",
-        &out.display().to_string(),
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "fuzz",
+            "psx3xx",
+            "--dut",
+            &dut,
+            "--iterations",
+            "15",
+            "--seed",
+            "4",
+            "--quiet",
+            "--out",
+            &out.display().to_string(),
+        ],
+    );
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(
         stdout.contains("15 sequence(s)") && stdout.contains("0 finding(s)"),
@@ -121,22 +107,22 @@ const REPLAY: &str = r#"{
 
 #[test]
 fn a_replay_gives_the_same_exchanges_on_sim_and_over_exec() {
-    let out = temp("replay");
+    let out = temp_dir("fuzz-psx-cli", "replay");
     std::fs::create_dir_all(&out).unwrap();
     let file = out.join("sequence.json");
     std::fs::write(&file, REPLAY).unwrap();
     let f = file.display().to_string();
-    let (code, on_sim, stderr) = drivespec(&["fuzz", "psx3xx", "--replay", &f]);
+    let (code, on_sim, stderr) = run(BIN, &["fuzz", "psx3xx", "--replay", &f]);
     assert_eq!(code, 0, "{on_sim}{stderr}");
     assert!(on_sim.contains(": passes"), "{on_sim}");
     assert!(on_sim.contains("ISDU-WRITE"), "{on_sim}");
     let dut = exec_sim();
-    let (code, on_exec, stderr) = drivespec(&["fuzz", "psx3xx", "--dut", &dut, "--replay", &f]);
+    let (code, on_exec, stderr) = run(BIN, &["fuzz", "psx3xx", "--dut", &dut, "--replay", &f]);
     assert_eq!(code, 0, "{on_exec}{stderr}");
     // Byte for byte the same exchanges on both transports (virtual time).
     assert_eq!(on_sim, on_exec);
     // A PSx3xx replay is refused for psd4xx (exit 2).
-    let (code, _, stderr) = drivespec(&["fuzz", "psd4xx", "--replay", &f]);
+    let (code, _, stderr) = run(BIN, &["fuzz", "psd4xx", "--replay", &f]);
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("psx3xx"), "{stderr}");
     std::fs::remove_dir_all(&out).unwrap();
@@ -154,27 +140,30 @@ fn a_device_that_dies_or_hangs_is_a_finding_and_the_run_goes_on() {
     }
     let relay = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/dying_psx3xx_relay.py");
     let dut = format!("exec:python3 {} {BIN} sim psx3xx --stdio", relay.display());
-    let out = temp("dying");
+    let out = temp_dir("fuzz-psx-cli", "dying");
     let dir = out.display().to_string();
-    let (code, stdout, stderr) = drivespec(&[
-        "--format",
-        "json",
-        "fuzz",
-        "psx3xx",
-        "--dut",
-        &dut,
-        "--iterations",
-        "25",
-        "--seed",
-        "2",
-        "--max-findings",
-        "10",
-        "--minimize-runs",
-        "8",
-        "--quiet",
-        "--out",
-        &dir,
-    ]);
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "--format",
+            "json",
+            "fuzz",
+            "psx3xx",
+            "--dut",
+            &dut,
+            "--iterations",
+            "25",
+            "--seed",
+            "2",
+            "--max-findings",
+            "10",
+            "--minimize-runs",
+            "8",
+            "--quiet",
+            "--out",
+            &dir,
+        ],
+    );
     assert_eq!(code, 1, "{stdout}{stderr}");
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(v["sequences"], 25, "the run went on to the end: {stdout}");
@@ -199,9 +188,9 @@ fn a_device_that_dies_or_hangs_is_a_finding_and_the_run_goes_on() {
     assert_eq!(hang["signature"], "hang/advance", "{hang}");
     // The crash replays: it still fails, against the reference it passes.
     let file = crash["file"].as_str().unwrap();
-    let (code, stdout, stderr) = drivespec(&["fuzz", "psx3xx", "--dut", &dut, "--replay", file]);
+    let (code, stdout, stderr) = run(BIN, &["fuzz", "psx3xx", "--dut", &dut, "--replay", file]);
     assert_eq!(code, 1, "{stdout}{stderr}");
-    let (code, stdout, _) = drivespec(&["fuzz", "psx3xx", "--replay", file]);
+    let (code, stdout, _) = run(BIN, &["fuzz", "psx3xx", "--replay", file]);
     assert_eq!(code, 0, "{stdout}");
     std::fs::remove_dir_all(&out).unwrap();
 }

@@ -6,19 +6,7 @@
     clippy::panic
 )]
 
-use std::process::Command;
-
-fn drivespec(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_drivespec"))
-        .args(args)
-        .output()
-        .expect("run drivespec");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use drivespec_testkit::run;
 
 /// The eight examples of manual 4.1, requests and answers, as one line.
 const CASES: &str = "7E 80 01 54 D5 7E 20 01 54 09 7E 00 \
@@ -30,9 +18,14 @@ const CASES: &str = "7E 80 01 54 D5 7E 20 01 54 09 7E 00 \
     7E 60 02 00 40 5A FC 7E 20 \
     7E 40 04 00 44 7E 20 04 00 10 5A A7 5A 8F";
 
+const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
+
 #[test]
 fn decode_manual_form_of_case_2() {
-    let (code, out, _) = drivespec(&["decode", "hpd", "[$7E][$21][$02][$42][$D0][$07][$3C]"]);
+    let (code, out, _) = run(
+        BIN,
+        &["decode", "hpd", "[$7E][$21][$02][$42][$D0][$07][$3C]"],
+    );
     assert_eq!(code, 0);
     insta::assert_snapshot!(out);
 }
@@ -43,45 +36,51 @@ fn decode_the_eight_manual_examples_as_a_line() {
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("line.hex");
     std::fs::write(&file, CASES).unwrap();
-    let (code, text, _) = drivespec(&["decode", "hpd", "--stream", file.to_str().unwrap()]);
+    let (code, text, _) = run(BIN, &["decode", "hpd", "--stream", file.to_str().unwrap()]);
     assert_eq!(code, 0, "{text}");
     insta::assert_snapshot!("line_text", text);
-    let (code, json, _) = drivespec(&[
-        "decode",
-        "hpd",
-        "--stream",
-        file.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let (code, json, _) = run(
+        BIN,
+        &[
+            "decode",
+            "hpd",
+            "--stream",
+            file.to_str().unwrap(),
+            "--format",
+            "json",
+        ],
+    );
     assert_eq!(code, 0);
     insta::assert_snapshot!("line_json", json);
     // The same bytes raw give the same result.
     let raw = drivespec_spec::hex::parse_hex(CASES).unwrap();
     let bin = dir.join("line.bin");
     std::fs::write(&bin, raw).unwrap();
-    let (_, raw_json, _) = drivespec(&[
-        "decode",
-        "hpd",
-        "--stream",
-        bin.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let (_, raw_json, _) = run(
+        BIN,
+        &[
+            "decode",
+            "hpd",
+            "--stream",
+            bin.to_str().unwrap(),
+            "--format",
+            "json",
+        ],
+    );
     assert_eq!(raw_json, json);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn decode_reports_a_bad_checksum_and_exits_1() {
-    let (code, out, _) = drivespec(&["decode", "hpd", "7E 80 01 54 D6"]);
+    let (code, out, _) = run(BIN, &["decode", "hpd", "7E 80 01 54 D6"]);
     assert_eq!(code, 1);
     insta::assert_snapshot!(out);
 }
 
 #[test]
 fn decode_rejects_odd_hex_with_exit_2() {
-    let (code, out, err) = drivespec(&["decode", "hpd", "7E 8"]);
+    let (code, out, err) = run(BIN, &["decode", "hpd", "7E 8"]);
     assert_eq!((code, out.as_str()), (2, ""));
     assert_eq!(
         err,
@@ -109,12 +108,15 @@ fn encode_rebuilds_the_manual_requests_from_names() {
     for (args, want) in cases {
         let mut full = vec!["encode", "hpd"];
         full.extend_from_slice(args);
-        let (code, out, err) = drivespec(&full);
+        let (code, out, err) = run(BIN, &full);
         assert_eq!((code, out.trim()), (0, want), "{args:?}: {err}");
     }
-    let (code, out, _) = drivespec(&[
-        "encode", "hpd", "plc-read", "--addr", "0", "--at", "0", "--lun", "4",
-    ]);
+    let (code, out, _) = run(
+        BIN,
+        &[
+            "encode", "hpd", "plc-read", "--addr", "0", "--at", "0", "--lun", "4",
+        ],
+    );
     assert_eq!((code, out.trim()), (0, "7E 40 04 00 44"));
 }
 
@@ -138,17 +140,17 @@ fn encode_errors_are_one_line_with_exit_2() {
     for (args, want) in cases {
         let mut full = vec!["encode", "hpd"];
         full.extend_from_slice(args);
-        let (code, _, err) = drivespec(&full);
+        let (code, _, err) = run(BIN, &full);
         assert_eq!((code, err.as_str()), (2, want), "{args:?}");
     }
 }
 
 #[test]
 fn disassemble_case_8_and_flag_a_program_without_end() {
-    let (code, out, _) = drivespec(&["plc", "hpd", "disasm", "10 5A A7 5A 0F 00"]);
+    let (code, out, _) = run(BIN, &["plc", "hpd", "disasm", "10 5A A7 5A 0F 00"]);
     assert_eq!(code, 0);
     insta::assert_snapshot!(out);
-    let (code, _, err) = drivespec(&["plc", "hpd", "disasm", "10 5A A7 5A"]);
+    let (code, _, err) = run(BIN, &["plc", "hpd", "disasm", "10 5A A7 5A"]);
     assert_eq!(
         (code, err.as_str()),
         (2, "drivespec: program has no END within 4 bytes\n")
@@ -165,7 +167,7 @@ fn assemble_reports_fin_out_of_place_and_exits_1() {
         "; FIN after another instruction is a no-op\nLD 90.1\nFIN 3,1\nOUT 91.0\nEND\n",
     )
     .unwrap();
-    let (code, out, _) = drivespec(&["plc", "hpd", "asm", file.to_str().unwrap()]);
+    let (code, out, _) = run(BIN, &["plc", "hpd", "asm", file.to_str().unwrap()]);
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(code, 1);
     insta::assert_snapshot!(out);

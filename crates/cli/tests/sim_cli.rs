@@ -9,34 +9,17 @@
     clippy::panic
 )]
 
-use std::io::{BufRead, BufReader, Read, Write};
+use drivespec_testkit::{run, temp_dir, Sim};
+use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::path::PathBuf;
-use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::{Duration, Instant};
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
-fn drivespec(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("run drivespec");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn report_dir(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("drivespec-sim-{name}-{}", std::process::id()))
-}
-
 /// `drivespec conform hpd` on `dut` with `cases`; a failing run is repeated once (cases that
 /// read real time closely can miss under heavy load). Returns the last exit code and stdout.
 fn conform(dut: &str, cases: &[&str], name: &str) -> (i32, String) {
-    let dir = report_dir(name);
+    let dir = temp_dir("sim", name);
     let mut args = vec![
         "conform".to_owned(),
         "hpd".to_owned(),
@@ -51,60 +34,13 @@ fn conform(dut: &str, cases: &[&str], name: &str) -> (i32, String) {
         args.push((*c).to_owned());
     }
     let argv: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (mut code, mut out, _) = drivespec(&argv);
+    let (mut code, mut out, _) = run(BIN, &argv);
     if code == 1 {
         eprintln!("run again after a failure (timing under load?):\n{out}");
-        (code, out, _) = drivespec(&argv);
+        (code, out, _) = run(BIN, &argv);
     }
     let _ = std::fs::remove_dir_all(&dir);
     (code, out)
-}
-
-/// A `drivespec sim` process, killed when dropped.
-struct Sim {
-    child: Child,
-    stdout: BufReader<ChildStdout>,
-}
-
-impl Sim {
-    fn start(args: &[&str]) -> Sim {
-        let mut child = Command::new(BIN)
-            .arg("sim")
-            .args(args)
-            .args(["--time-limit", "60"])
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let stdout = BufReader::new(child.stdout.take().unwrap());
-        Sim { child, stdout }
-    }
-
-    /// The one line the server prints on stdout: the pty path or the TCP address.
-    fn first_line(&mut self) -> String {
-        let mut line = String::new();
-        self.stdout.read_line(&mut line).unwrap();
-        line.trim().to_owned()
-    }
-
-    /// Stops the server and returns its stderr.
-    fn stop(mut self) -> String {
-        let _ = self.child.kill();
-        let mut err = String::new();
-        if let Some(mut e) = self.child.stderr.take() {
-            let _ = e.read_to_string(&mut err);
-        }
-        let _ = self.child.wait();
-        err
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
 }
 
 #[test]
@@ -121,21 +57,24 @@ fn stdio_serves_an_exec_device_under_test() {
 
 #[test]
 fn stdio_with_corrupt_checksums_fails_the_read() {
-    let dir = report_dir("corrupt");
+    let dir = temp_dir("sim", "corrupt");
     let dut = format!("exec:{BIN} sim hpd --stdio --corrupt-checksums 1.0 --time-limit 60");
-    let (code, out, _) = drivespec(&[
-        "conform",
-        "hpd",
-        "--dut",
-        &dut,
-        "--case",
-        "hpd/frame/read-parameter",
-        "--case",
-        "hpd/frame/foreign-address/7",
-        "--quiet",
-        "--report-dir",
-        &dir.display().to_string(),
-    ]);
+    let (code, out, _) = run(
+        BIN,
+        &[
+            "conform",
+            "hpd",
+            "--dut",
+            &dut,
+            "--case",
+            "hpd/frame/read-parameter",
+            "--case",
+            "hpd/frame/foreign-address/7",
+            "--quiet",
+            "--report-dir",
+            &dir.display().to_string(),
+        ],
+    );
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(code, 1, "{out}");
     // The read's answer fails; silence to a foreign address is still right.
@@ -145,7 +84,7 @@ fn stdio_with_corrupt_checksums_fails_the_read() {
 #[cfg(unix)]
 #[test]
 fn pty_path_works_as_a_serial_device_under_test() {
-    let mut sim = Sim::start(&["hpd", "--pty"]);
+    let mut sim = Sim::start(BIN, &["hpd", "--pty"]);
     let path = sim.first_line();
     assert!(path.starts_with("/dev/"), "{path}");
     let (code, out) = conform(
@@ -167,7 +106,10 @@ fn pty_path_works_as_a_serial_device_under_test() {
 
 #[test]
 fn listen_prints_the_address_and_logs_the_traffic_in_words() {
-    let mut sim = Sim::start(&["hpd", "--listen", "tcp:127.0.0.1:0", "--log", "--addr", "1"]);
+    let mut sim = Sim::start(
+        BIN,
+        &["hpd", "--listen", "tcp:127.0.0.1:0", "--log", "--addr", "1"],
+    );
     let addr = sim.first_line();
     let mut s = TcpStream::connect(&addr).unwrap();
     s.set_read_timeout(Some(Duration::from_millis(200)))
@@ -205,7 +147,7 @@ fn bad_usage_exits_2() {
         &["sim", "hpd", "--stdio", "--addr", "40"],
         &["sim", "nope", "--stdio"],
     ] {
-        let (code, _, err) = drivespec(args);
+        let (code, _, err) = run(BIN, args);
         assert_eq!(code, 2, "{args:?}: {err}");
     }
 }

@@ -9,83 +9,11 @@
     clippy::panic
 )]
 
-use std::io::{BufRead, BufReader, Read, Write};
-use std::path::PathBuf;
-use std::process::{Child, ChildStdout, Command, Stdio};
+use drivespec_testkit::{run_with, temp_dir, Sim};
+use std::io::{Read, Write};
 use std::time::Duration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
-
-fn drivespec(args: &[&str], stdin: &str) -> (i32, String, String) {
-    let mut child = Command::new(BIN)
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run drivespec");
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(stdin.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn report_dir(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("drivespec-simc-{name}-{}", std::process::id()))
-}
-
-/// A `drivespec sim` process, killed when dropped.
-struct Sim {
-    child: Child,
-    stdout: BufReader<ChildStdout>,
-}
-
-impl Sim {
-    fn start(args: &[&str]) -> Sim {
-        let mut child = Command::new(BIN)
-            .arg("sim")
-            .args(args)
-            .args(["--time-limit", "60"])
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let stdout = BufReader::new(child.stdout.take().unwrap());
-        Sim { child, stdout }
-    }
-
-    fn first_line(&mut self) -> String {
-        let mut line = String::new();
-        self.stdout.read_line(&mut line).unwrap();
-        line.trim().to_owned()
-    }
-
-    fn stop(mut self) -> String {
-        let _ = self.child.kill();
-        let mut err = String::new();
-        if let Some(mut e) = self.child.stderr.take() {
-            let _ = e.read_to_string(&mut err);
-        }
-        let _ = self.child.wait();
-        err
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
 
 const CASES: &[&str] = &[
     "psd4xx/pkw/read/44",
@@ -97,7 +25,7 @@ const CASES: &[&str] = &[
 ];
 
 fn conform(dut: &str, name: &str) -> (i32, String) {
-    let dir = report_dir(name);
+    let dir = temp_dir("simc", name);
     let mut args = vec![
         "conform".to_owned(),
         "psd4xx".to_owned(),
@@ -112,14 +40,14 @@ fn conform(dut: &str, name: &str) -> (i32, String) {
         args.push((*c).to_owned());
     }
     let argv: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (code, out, err) = drivespec(&argv, "");
+    let (code, out, err) = run_with(BIN, &argv, Some(""), &[]);
     let _ = std::fs::remove_dir_all(&dir);
     (code, format!("{out}{err}"))
 }
 
 #[test]
 fn listen_serves_conform_over_tcp() {
-    let mut sim = Sim::start(&["psd4xx", "--listen", "tcp:127.0.0.1:0"]);
+    let mut sim = Sim::start(BIN, &["psd4xx", "--listen", "tcp:127.0.0.1:0"]);
     let addr = sim.first_line();
     assert!(addr.starts_with("127.0.0.1:"), "{addr}");
     let (code, out) = conform(&format!("tcp:{addr}"), "tcp");
@@ -132,10 +60,7 @@ fn listen_serves_conform_over_tcp() {
 
 #[test]
 fn stdio_answers_an_exchange_and_serves_exec() {
-    let (code, out, err) = drivespec(
-        &["sim", "psd4xx", "--stdio", "--model", "PSD426"],
-        "HELLO drivespec-cyclic 1 psd4xx PSD426\nRESET\nCYCLE 10000 0000000000000000000000000000\nCYCLE 20000 102c000000000000000000000000\nbogus\n",
-    );
+    let (code, out, err) = run_with(BIN, &["sim", "psd4xx", "--stdio", "--model", "PSD426"], Some("HELLO drivespec-cyclic 1 psd4xx PSD426\nRESET\nCYCLE 10000 0000000000000000000000000000\nCYCLE 20000 102c000000000000000000000000\nbogus\n"), &[]);
     assert_eq!(code, 0, "{err}");
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(lines.len(), 5, "{out}");
@@ -159,15 +84,22 @@ fn stdio_answers_an_exchange_and_serves_exec() {
 #[test]
 fn faults_drop_and_corrupt_replies() {
     let input = "HELLO drivespec-cyclic 1 psd4xx PSD401-5V\nRESET\nCYCLE 10000 0000000000000000000000000000\n";
-    let (code, out, err) = drivespec(&["sim", "psd4xx", "--stdio", "--drop-answers", "1"], input);
+    let (code, out, err) = run_with(
+        BIN,
+        &["sim", "psd4xx", "--stdio", "--drop-answers", "1"],
+        Some(input),
+        &[],
+    );
     assert_eq!(code, 0, "{err}");
     assert!(out.is_empty(), "{out}");
     assert!(err.contains("3 dropped"), "{err}");
-    let (code, clean, _) = drivespec(&["sim", "psd4xx", "--stdio"], input);
+    let (code, clean, _) = run_with(BIN, &["sim", "psd4xx", "--stdio"], Some(input), &[]);
     assert_eq!(code, 0);
-    let (code, bad, err) = drivespec(
+    let (code, bad, err) = run_with(
+        BIN,
         &["sim", "psd4xx", "--stdio", "--corrupt-images", "1", "--log"],
-        input,
+        Some(input),
+        &[],
     );
     assert_eq!(code, 0, "{err}");
     let (c, b): (Vec<&str>, Vec<&str>) = (clean.lines().collect(), bad.lines().collect());
@@ -183,7 +115,7 @@ fn faults_drop_and_corrupt_replies() {
 #[cfg(unix)]
 #[test]
 fn pty_speaks_the_line_protocol() {
-    let mut sim = Sim::start(&["psd4xx", "--pty"]);
+    let mut sim = Sim::start(BIN, &["psd4xx", "--pty"]);
     let path = sim.first_line();
     assert!(path.starts_with("/dev/"), "{path}");
     let mut f = std::fs::OpenOptions::new()
@@ -217,7 +149,7 @@ fn bad_usage_exits_2() {
         &["sim", "hpd", "--stdio", "--corrupt-images", "0.5"],
         &["sim", "psd4xx", "--listen", "udp:127.0.0.1:0"],
     ] {
-        let (code, _, err) = drivespec(args, "");
+        let (code, _, err) = run_with(BIN, args, Some(""), &[]);
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(err.starts_with("drivespec: "), "{err}");
     }
@@ -225,9 +157,11 @@ fn bad_usage_exits_2() {
 
 #[test]
 fn psx3xx_is_served_on_stdio() {
-    let (code, out, err) = drivespec(
+    let (code, out, err) = run_with(
+        BIN,
         &["sim", "psx3xx", "--stdio"],
-        "HELLO drivespec-cyclic 1 psx3xx x\nRESET\nHELLO drivespec-cyclic 1 psd4xx x\n",
+        Some("HELLO drivespec-cyclic 1 psx3xx x\nRESET\nHELLO drivespec-cyclic 1 psd4xx x\n"),
+        &[],
     );
     assert_eq!(code, 0, "{err}");
     let lines: Vec<&str> = out.lines().collect();

@@ -8,9 +8,8 @@
     clippy::panic
 )]
 
-use std::io::Write;
+use drivespec_testkit::run_with;
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
@@ -21,36 +20,16 @@ fn example(name: &str) -> String {
     p.to_string_lossy().into_owned()
 }
 
-fn drivespec(args: &[&str], stdin: Option<&str>) -> (i32, String, String) {
-    let mut child = Command::new(BIN)
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run drivespec");
-    {
-        let mut input = child.stdin.take().unwrap();
-        if let Some(text) = stdin {
-            input.write_all(text.as_bytes()).unwrap();
-        }
-    }
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn positioning_example_trace() {
     let script = example("psd4xx_positioning.sim");
-    let (code, out, err) = drivespec(
+    let (code, out, err) = run_with(
+        BIN,
         &[
             "sim-run", "psd4xx", "--model", "PSD426", "--script", &script, "--every", "1000",
         ],
         None,
+        &[],
     );
     assert_eq!(code, 0, "{err}\n{out}");
     insta::assert_snapshot!("psd4xx_positioning", out);
@@ -59,7 +38,8 @@ fn positioning_example_trace() {
 #[test]
 fn faults_example_trace() {
     let script = example("psd4xx_faults.sim");
-    let (code, out, err) = drivespec(
+    let (code, out, err) = run_with(
+        BIN,
         &[
             "sim-run",
             "psd4xx",
@@ -71,6 +51,7 @@ fn faults_example_trace() {
             "1000",
         ],
         None,
+        &[],
     );
     assert_eq!(code, 0, "{err}\n{out}");
     insta::assert_snapshot!("psd4xx_faults", out);
@@ -81,7 +62,8 @@ fn faults_example_trace() {
 #[test]
 fn psx3xx_example_runs() {
     let script = example("psx3xx_positioning.sim");
-    let (code, out, err) = drivespec(
+    let (code, out, err) = run_with(
+        BIN,
         &[
             "sim-run",
             "psx3xx",
@@ -93,6 +75,7 @@ fn psx3xx_example_runs() {
             "0",
         ],
         None,
+        &[],
     );
     assert_eq!(code, 0, "{err}\n{out}");
     assert!(out.starts_with("psx3xx PSE335-14\n"), "{out}");
@@ -103,12 +86,14 @@ fn psx3xx_example_runs() {
 #[test]
 fn json_trace_and_failed_expectation_exit_1() {
     let script = "0 ms: control 0x14 target 400\n100 ms: expect position = 400\n";
-    let (code, out, _) = drivespec(
+    let (code, out, _) = run_with(
+        BIN,
         &[
             "sim-run", "psd4xx", "--model", "PSD426", "--script", "-", "--every", "0", "--format",
             "json",
         ],
         Some(script),
+        &[],
     );
     assert_eq!(code, 1);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
@@ -134,18 +119,22 @@ fn script_errors_name_the_line_and_exit_2() {
         ("0 ms: record write 44 zz\n", "hex byte"),
     ];
     for (script, needle) in cases {
-        let (code, out, err) = drivespec(
+        let (code, out, err) = run_with(
+            BIN,
             &["sim-run", "psd4xx", "--model", "PSD426", "--script", "-"],
             Some(script),
+            &[],
         );
         assert_eq!(code, 2, "{script}: {out}");
         assert!(err.starts_with("drivespec: "), "{err}");
         assert!(err.contains(needle), "{script}: {err}");
         assert_eq!(err.lines().count(), 1, "{err}");
     }
-    let (code, _, err) = drivespec(
+    let (code, _, err) = run_with(
+        BIN,
         &["sim-run", "psd4xx", "--model", "PSD999", "--script", "-"],
         Some("0 ms: end\n"),
+        &[],
     );
     assert_eq!(code, 2);
     assert!(err.contains("PSD426"), "{err}");

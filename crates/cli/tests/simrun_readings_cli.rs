@@ -8,8 +8,7 @@
     clippy::panic
 )]
 
-use std::io::Write;
-use std::process::{Command, Stdio};
+use drivespec_testkit::run_with;
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
@@ -21,25 +20,7 @@ fn sim_run(extra: &[&str]) -> (i32, String, String) {
         "sim-run", "psx3xx", "--model", "PSE312-8", "--script", "-", "--every", "0",
     ];
     args.extend_from_slice(extra);
-    let mut child = Command::new(BIN)
-        .args(&args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run drivespec");
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(SCRIPT.as_bytes())
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    run_with(BIN, &args, Some(SCRIPT), &[])
 }
 
 fn isdu_127(out: &str) -> &str {

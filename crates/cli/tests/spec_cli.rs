@@ -6,62 +6,46 @@
     clippy::panic
 )]
 
-use std::process::Command;
+use drivespec_testkit::run;
 
-struct Run {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-fn drivespec(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_drivespec"))
-        .args(args)
-        .output()
-        .expect("run drivespec");
-    Run {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
+const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
 #[test]
 fn builtin_spec_checks_clean() {
-    let r = drivespec(&["spec", "check"]);
-    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
-    assert!(r.stdout.ends_with("spec ok\n"), "{}", r.stdout);
+    let (code, stdout, stderr) = run(BIN, &["spec", "check"]);
+    assert_eq!(code, 0, "{}{}", stdout, stderr);
+    assert!(stdout.ends_with("spec ok\n"), "{}", stdout);
 }
 
 #[test]
 fn unknown_device_is_bad_usage() {
-    let r = drivespec(&["spec", "list", "psd5xx"]);
-    assert_eq!(r.code, 2);
+    let (code, _, stderr) = run(BIN, &["spec", "list", "psd5xx"]);
+    assert_eq!(code, 2);
     assert_eq!(
-        r.stderr,
+        stderr,
         "drivespec: unknown device \"psd5xx\"; expected one of: hpd, psd4xx, psx3xx\n"
     );
 }
 
 #[test]
 fn unknown_subcommand_is_bad_usage() {
-    assert_eq!(drivespec(&["spec", "lsit", "hpd"]).code, 2);
-    assert_eq!(drivespec(&[]).code, 2);
+    assert_eq!(run(BIN, &["spec", "lsit", "hpd"]).0, 2);
+    assert_eq!(run(BIN, &[]).0, 2);
 }
 
 #[test]
 fn help_exits_zero() {
-    let r = drivespec(&["--help"]);
-    assert_eq!(r.code, 0);
-    assert!(r.stdout.contains("spec"), "{}", r.stdout);
+    let (code, stdout, _) = run(BIN, &["--help"]);
+    assert_eq!(code, 0);
+    assert!(stdout.contains("spec"), "{}", stdout);
 }
 
 #[test]
 fn missing_spec_folder_is_unreadable_input() {
-    let r = drivespec(&["spec", "check", "--spec", "/nonexistent/spec"]);
-    assert_eq!(r.code, 2);
+    let (code, _, stderr) = run(BIN, &["spec", "check", "--spec", "/nonexistent/spec"]);
+    assert_eq!(code, 2);
     assert_eq!(
-        r.stderr,
+        stderr,
         "drivespec: cannot read spec folder /nonexistent/spec: not a directory\n"
     );
 }
@@ -77,11 +61,11 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
         "[[requirement]]\nid = \"PSD-X\"\nlevel = \"must\"\ntext = \"t\"\nsource = \"1\"\n\n[[requirement]]\nid = \"PSD-FIXTURE-1\"\nlevel = \"maybe\"\ntext = \"t\"\nsource = \"1\"\n",
     )
     .unwrap();
-    let r = drivespec(&["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let (code, stdout, stderr) = run(BIN, &["spec", "check", "--spec", dir.to_str().unwrap()]);
     let _ = std::fs::remove_dir_all(&dir);
-    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
-    let lines: Vec<&str> = r.stdout.lines().collect();
-    assert_eq!(lines.len(), 2, "{}", r.stdout);
+    assert_eq!(code, 1, "{}{}", stdout, stderr);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{}", stdout);
     assert!(
         lines[0].starts_with(
             "psd4xx/zz-broken.toml: requirement \"PSD-FIXTURE-1\": unknown variant `maybe`"
@@ -97,29 +81,32 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
         lines[1]
     );
 
-    let json = drivespec(&[
-        "spec",
-        "check",
-        "--format",
-        "json",
-        "--spec",
-        "/nonexistent",
-    ]);
-    assert_eq!(json.code, 2);
+    let (code, _, _) = run(
+        BIN,
+        &[
+            "spec",
+            "check",
+            "--format",
+            "json",
+            "--spec",
+            "/nonexistent",
+        ],
+    );
+    assert_eq!(code, 2);
 }
 
 #[test]
 fn check_json_is_machine_readable() {
-    let r = drivespec(&["spec", "check", "--format", "json"]);
-    assert_eq!(r.code, 0);
-    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let (code, stdout, _) = run(BIN, &["spec", "check", "--format", "json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(v["ok"], true);
     assert_eq!(v["problems"].as_array().map(Vec::len), Some(0));
 }
 
 /// `spec check` on a copy of the builtin spec in which `edit` changed the family folder
 /// `family`'s files.
-fn check_edited(name: &str, family: &str, edit: impl Fn(&str) -> String) -> Run {
+fn check_edited(name: &str, family: &str, edit: impl Fn(&str) -> String) -> (i32, String, String) {
     let dir = std::env::temp_dir().join(format!("drivespec-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec");
@@ -136,7 +123,7 @@ fn check_edited(name: &str, family: &str, edit: impl Fn(&str) -> String) -> Run 
             }
         }
     }
-    let r = drivespec(&["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let r = run(BIN, &["spec", "check", "--spec", dir.to_str().unwrap()]);
     let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(changed, 1, "the edit {name} changed {changed} files");
     r
@@ -156,41 +143,41 @@ fn without_requirement(text: &str, id: &str) -> String {
 #[test]
 fn a_spec_edit_that_breaks_case_generation_fails_check() {
     // Only a PSx3xx case cites this requirement: the spec loads, the cases cannot be made.
-    let r = check_edited("no-case-requirement", "psx3xx", |t| {
+    let (code, stdout, stderr) = check_edited("no-case-requirement", "psx3xx", |t| {
         without_requirement(t, "PSX-ISDU-181-BIT4")
     });
-    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
-    assert!(!r.stdout.contains("spec ok"), "{}", r.stdout);
-    let lines: Vec<&str> = r.stdout.lines().collect();
+    assert_eq!(code, 1, "{}{}", stdout, stderr);
+    assert!(!stdout.contains("spec ok"), "{}", stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
     assert!(
         lines.iter().any(|l| l.starts_with(
             "psx3xx: model \"PSE312-8\": the conformance cases cannot be generated: "
         ) && l.contains("unknown requirement PSX-ISDU-181-BIT4")),
         "{}",
-        r.stdout
+        stdout
     );
     // Every problem is a PSx3xx model's cases: the simulator does not need the requirement.
     assert!(
         lines.iter().all(|l| l.starts_with("psx3xx: model ")
             && l.contains(": the conformance cases cannot be generated: ")),
         "{}",
-        r.stdout
+        stdout
     );
 }
 
 #[test]
 fn a_spec_edit_that_breaks_the_simulator_fails_check() {
     // The reference PSx3xx drive takes the orange LED's acknowledge time from this pattern.
-    let r = check_edited("no-led-dark", "psx3xx", |t| {
+    let (code, stdout, stderr) = check_edited("no-led-dark", "psx3xx", |t| {
         t.replace("pattern = \"dark-250ms\"", "pattern = \"dark\"")
     });
-    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    assert_eq!(code, 1, "{}{}", stdout, stderr);
     assert!(
-        r.stdout.lines().any(|l| l
+        stdout.lines().any(|l| l
             == "psx3xx: model \"PSE312-8\": the simulator cannot be built: the reference model \
                 cannot be built: spec: no dark-<n>ms state of the orange LED"),
         "{}",
-        r.stdout
+        stdout
     );
 }
 
@@ -222,26 +209,29 @@ fn spec_show_snapshots() {
         &["spec", "show", "psx3xx", "64"],
     ];
     for args in cases {
-        let r = drivespec(args);
-        assert_eq!(r.code, 0, "{args:?}: {}", r.stderr);
-        insta::assert_snapshot!(args[2..].join("_").replace(' ', "_"), r.stdout);
+        let (code, stdout, stderr) = run(BIN, args);
+        assert_eq!(code, 0, "{args:?}: {}", stderr);
+        insta::assert_snapshot!(args[2..].join("_").replace(' ', "_"), stdout);
     }
 }
 
 #[test]
 fn spec_show_json_is_the_record_plus_the_resolution() {
-    let r = drivespec(&[
-        "spec",
-        "show",
-        "psd4xx",
-        "63",
-        "--model",
-        "psd 426/436-14h",
-        "--format",
-        "json",
-    ]);
-    assert_eq!(r.code, 0);
-    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let (code, stdout, _) = run(
+        BIN,
+        &[
+            "spec",
+            "show",
+            "psd4xx",
+            "63",
+            "--model",
+            "psd 426/436-14h",
+            "--format",
+            "json",
+        ],
+    );
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(v["model"], "PSD426-14H");
     assert_eq!(v["resolved"]["range"], serde_json::json!([[150, 720]]));
     assert_eq!(v["resolved"]["default"], 360);
@@ -251,13 +241,12 @@ fn spec_show_json_is_the_record_plus_the_resolution() {
 
 #[test]
 fn unknown_model_lists_the_known_ones() {
-    let r = drivespec(&["spec", "show", "psd4xx", "63", "--model", "PSD999"]);
-    assert_eq!(r.code, 2);
+    let (code, _, stderr) = run(BIN, &["spec", "show", "psd4xx", "63", "--model", "PSD999"]);
+    assert_eq!(code, 2);
     assert!(
-        r.stderr
-            .starts_with("drivespec: unknown psd4xx model \"PSD999\"; known models: PSD401-5V, "),
+        stderr.starts_with("drivespec: unknown psd4xx model \"PSD999\"; known models: PSD401-5V, "),
         "{}",
-        r.stderr
+        stderr
     );
 }
 
@@ -269,31 +258,37 @@ fn models_match_forgivingly() {
         ("psx3xx", "PSE335-14", "PSE335-14"),
         ("psx3xx", "pse 335-14", "PSE335-14"),
     ] {
-        let r = drivespec(&["spec", "list", family, "--model", query, "--format", "json"]);
-        assert_eq!(r.code, 0, "{query}: {}", r.stderr);
-        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        let (code, stdout, stderr) = run(
+            BIN,
+            &["spec", "list", family, "--model", query, "--format", "json"],
+        );
+        assert_eq!(code, 0, "{query}: {}", stderr);
+        let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
         assert_eq!(v["model"], want, "{query}");
     }
 }
 
 #[test]
 fn models_and_errata_listings() {
-    let r = drivespec(&["spec", "models", "psd4xx"]);
-    assert_eq!(r.code, 0);
-    insta::assert_snapshot!("models_psd4xx", r.stdout);
-    let r = drivespec(&["spec", "errata", "hpd"]);
-    assert_eq!(r.code, 0);
-    assert!(r.stdout.contains("HPD-ERRATUM-001: b99.3"), "{}", r.stdout);
-    let r = drivespec(&[
-        "spec",
-        "requirements",
-        "psd4xx",
-        "--level",
-        "must",
-        "--format",
-        "json",
-    ]);
-    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let (code, stdout, _) = run(BIN, &["spec", "models", "psd4xx"]);
+    assert_eq!(code, 0);
+    insta::assert_snapshot!("models_psd4xx", stdout);
+    let (code, stdout, _) = run(BIN, &["spec", "errata", "hpd"]);
+    assert_eq!(code, 0);
+    assert!(stdout.contains("HPD-ERRATUM-001: b99.3"), "{}", stdout);
+    let (_, stdout, _) = run(
+        BIN,
+        &[
+            "spec",
+            "requirements",
+            "psd4xx",
+            "--level",
+            "must",
+            "--format",
+            "json",
+        ],
+    );
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert!(v["requirements"]
         .as_array()
         .unwrap()

@@ -6,6 +6,7 @@
 //! [`WireError`], never a panic.
 
 use drivespec_psd4xx::model::LinkEvent;
+use drivespec_spec::hex::{parse_hex_compact, to_hex_compact};
 use std::fmt;
 
 /// Protocol version this runner speaks.
@@ -174,28 +175,12 @@ fn bad(line: &str, what: &str) -> WireError {
     }
 }
 
-/// Hex without separators.
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02X}")).collect()
-}
-
-/// Parses hex without separators.
-pub fn unhex(s: &str) -> Option<Vec<u8>> {
-    if s.len() % 2 != 0 || !s.is_ascii() {
-        return None;
-    }
-    (0..s.len())
-        .step_by(2)
-        .map(|i| s.get(i..i + 2).and_then(|p| u8::from_str_radix(p, 16).ok()))
-        .collect()
-}
-
 /// A byte string as one protocol word: hex, or `-` when empty.
 fn word(bytes: &[u8]) -> String {
     if bytes.is_empty() {
         "-".to_owned()
     } else {
-        hex(bytes)
+        to_hex_compact(bytes)
     }
 }
 
@@ -288,7 +273,7 @@ fn num<T: std::str::FromStr>(line: &str, w: Option<&str>, what: &str) -> Result<
 fn bytes(line: &str, w: Option<&str>) -> Result<Vec<u8>, WireError> {
     match w {
         Some("-") => Some(Vec::new()),
-        other => other.and_then(unhex),
+        other => other.and_then(parse_hex_compact),
     }
     .ok_or_else(|| bad(line, "expected hex bytes"))
 }

@@ -225,7 +225,7 @@ pub fn parse_value(p: &Parameter, text: &str) -> Result<i64, ParamError> {
     let t = text.trim();
     let bad = || ParamError::Value { text: t.to_owned() };
     if let Some(hex) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
-        return i64::from_str_radix(hex, 16).map_err(|_| bad());
+        return drivespec_spec::hex::parse_hex_digits(hex).ok_or_else(bad);
     }
     let scale = p.scale.unwrap_or(1.0);
     if scale == 1.0 {

@@ -61,14 +61,7 @@ impl Data {
 
 impl std::fmt::Debug for Data {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Data(")?;
-        for (i, b) in self.as_slice().iter().enumerate() {
-            if i > 0 {
-                f.write_str(" ")?;
-            }
-            write!(f, "{b:02X}")?;
-        }
-        f.write_str(")")
+        write!(f, "Data({})", drivespec_spec::hex::to_hex(self.as_slice()))
     }
 }
 

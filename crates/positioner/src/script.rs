@@ -28,6 +28,7 @@
 
 use crate::env::EnvChange;
 use crate::machine::{CoreEvent, Micros};
+use drivespec_spec::hex::IntError;
 use serde::Serialize;
 use std::fmt;
 
@@ -327,26 +328,13 @@ pub fn no_more(rest: &str) -> Result<(), LineError> {
 
 /// An integer: decimal with an optional sign, or `0x` hex, `_` allowed.
 pub fn parse_int(what: &'static str, text: &str) -> Result<i64, LineError> {
-    let bad = || LineError::BadNumber {
-        what,
-        found: text.to_owned(),
-    };
-    let t = text.trim().replace('_', "");
-    if t.is_empty() {
-        return Err(LineError::Missing { what });
-    }
-    let (neg, body) = match t.strip_prefix('-') {
-        Some(rest) => (true, rest),
-        None => (false, t.strip_prefix('+').unwrap_or(&t)),
-    };
-    let magnitude = match body.strip_prefix("0x").or_else(|| body.strip_prefix("0X")) {
-        Some(hex) => i64::from_str_radix(hex, 16).map_err(|_| bad())?,
-        None if !body.is_empty() && body.chars().all(|c| c.is_ascii_digit()) => {
-            body.parse::<i64>().map_err(|_| bad())?
-        }
-        None => return Err(bad()),
-    };
-    Ok(if neg { -magnitude } else { magnitude })
+    drivespec_spec::hex::parse_int(text).map_err(|e| match e {
+        IntError::Empty => LineError::Missing { what },
+        _ => LineError::BadNumber {
+            what,
+            found: text.to_owned(),
+        },
+    })
 }
 
 /// An integer that fits `T`.

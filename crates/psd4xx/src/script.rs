@@ -32,6 +32,7 @@ use drivespec_positioner::script::{
     Observation, Recorder, Script, ScriptError, Simulated, Trace,
 };
 use drivespec_positioner::{decode_bits, EnvChange, Micros};
+use drivespec_spec::hex::{parse_hex_digits, to_hex};
 use drivespec_spec::{FamilyId, Spec};
 use serde::Serialize;
 use std::fmt;
@@ -137,7 +138,7 @@ impl Dialect for PsdDialect<'_> {
                         let data = tail
                             .split_whitespace()
                             .map(|b| {
-                                u8::from_str_radix(b, 16).map_err(|_| LineError::BadNumber {
+                                parse_hex_digits(b).ok_or_else(|| LineError::BadNumber {
                                     what: "hex byte",
                                     found: b.to_owned(),
                                 })
@@ -273,12 +274,11 @@ impl PsdSim {
         while let Some(r) = self.drive.poll_record() {
             let (answer, meaning) = match &r.result {
                 Ok(RecordAnswer::Data { bytes }) => {
-                    let hex: Vec<String> = bytes.iter().map(|b| format!("{b:02X}")).collect();
                     let meaning = match self.drive.parameter(r.index) {
                         Ok(v) => format!("par {} = {v}", r.index),
                         Err(_) => format!("par {}", r.index),
                     };
-                    (format!("data {}", hex.join(" ")), meaning)
+                    (format!("data {}", to_hex(bytes)), meaning)
                 }
                 Ok(RecordAnswer::Written) => {
                     ("written".to_owned(), format!("par {} written", r.index))

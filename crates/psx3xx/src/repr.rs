@@ -165,7 +165,7 @@ pub fn parse_field_value(
     };
     let lower = digits.to_ascii_lowercase();
     let number = if let Some(h) = lower.strip_prefix("0x") {
-        i64::from_str_radix(&h.replace('_', ""), 16).ok()
+        drivespec_spec::hex::parse_hex_digits(&h.replace('_', ""))
     } else if let Some(b) = lower.strip_prefix("0b") {
         i64::from_str_radix(&b.replace('_', ""), 2).ok()
     } else {

@@ -30,6 +30,7 @@ use drivespec_positioner::script::{
     Observation, Recorder, Script, ScriptError, Simulated, Trace,
 };
 use drivespec_positioner::{decode_bits, EnvChange, Micros};
+use drivespec_spec::hex::to_hex;
 use drivespec_spec::{FamilyId, Spec};
 use serde::Serialize;
 use std::fmt;
@@ -330,7 +331,6 @@ impl<'s> PsxSim<'s> {
         while let Some(a) = self.drive.poll_isdu() {
             let (answer, meaning) = match &a.response {
                 Response::Read { data } => {
-                    let hex: Vec<String> = data.iter().map(|b| format!("{b:02X}")).collect();
                     let meaning = self
                         .drive
                         .rules()
@@ -338,7 +338,7 @@ impl<'s> PsxSim<'s> {
                         .ok()
                         .and_then(|t| self.drive.rules().decode_value(&t, data).ok())
                         .map_or_else(String::new, |v| format!("= {v}"));
-                    (format!("data {}", hex.join(" ")), meaning)
+                    (format!("data {}", to_hex(data)), meaning)
                 }
                 Response::Write if a.suppressed => (
                     "written".to_owned(),

@@ -10,6 +10,7 @@
 use super::SynthError;
 use drivespec_capture::iolink::{Access, IoLinkEvent, IoLinkKind, IsduResult};
 use drivespec_psx3xx::{ByteOrder, Input, Output, Rules, Stamp, TsCode};
+use drivespec_spec::hex::to_hex_lower;
 use drivespec_spec::Spec;
 
 /// A fault to plant in a generated IO-Link log, with the violations it must give.
@@ -288,10 +289,6 @@ pub fn psx_log(spec: &Spec, faults: &[PsxFault]) -> Result<Vec<IoLinkEvent>, Syn
     Ok(log.events)
 }
 
-fn hex(b: &[u8]) -> String {
-    b.iter().map(|x| format!("{x:02x}")).collect()
-}
-
 /// The events as JSON lines (IOLINK-LOG.md).
 pub fn to_jsonl(events: &[IoLinkEvent]) -> String {
     let mut s = String::new();
@@ -307,10 +304,10 @@ pub fn to_jsonl(events: &[IoLinkEvent]) -> String {
             IoLinkKind::ProcessData { out, input } => {
                 o.insert("kind".into(), "pd".into());
                 if let Some(b) = out {
-                    o.insert("out".into(), hex(b).into());
+                    o.insert("out".into(), to_hex_lower(b).into());
                 }
                 if let Some(b) = input {
-                    o.insert("in".into(), hex(b).into());
+                    o.insert("in".into(), to_hex_lower(b).into());
                 }
             }
             IoLinkKind::IsduRequest {
@@ -331,7 +328,7 @@ pub fn to_jsonl(events: &[IoLinkEvent]) -> String {
                 o.insert("index".into(), (*index).into());
                 o.insert("subindex".into(), (*subindex).into());
                 if *access == Access::Write {
-                    o.insert("data".into(), hex(data).into());
+                    o.insert("data".into(), to_hex_lower(data).into());
                 }
             }
             IoLinkKind::IsduResponse {
@@ -348,7 +345,7 @@ pub fn to_jsonl(events: &[IoLinkEvent]) -> String {
                 }
                 match result {
                     IsduResult::Data(d) => {
-                        o.insert("data".into(), hex(d).into());
+                        o.insert("data".into(), to_hex_lower(d).into());
                     }
                     IsduResult::Error(c) => {
                         o.insert("error".into(), format!("{c:#06x}").into());
@@ -394,8 +391,8 @@ pub fn to_csv(events: &[IoLinkEvent]) -> String {
         match &e.kind {
             IoLinkKind::ProcessData { out: o, input } => {
                 *kind = "pd".into();
-                *out = o.as_deref().map(hex).unwrap_or_default();
-                *inp = input.as_deref().map(hex).unwrap_or_default();
+                *out = o.as_deref().map(to_hex_lower).unwrap_or_default();
+                *inp = input.as_deref().map(to_hex_lower).unwrap_or_default();
             }
             IoLinkKind::IsduRequest {
                 access,
@@ -411,7 +408,7 @@ pub fn to_csv(events: &[IoLinkEvent]) -> String {
                 *index = i.to_string();
                 *subindex = si.to_string();
                 if *access == Access::Write {
-                    *data = hex(d);
+                    *data = to_hex_lower(d);
                 }
             }
             IoLinkKind::IsduResponse {
@@ -423,7 +420,7 @@ pub fn to_csv(events: &[IoLinkEvent]) -> String {
                 *index = i.map(|v| v.to_string()).unwrap_or_default();
                 *subindex = si.map(|v| v.to_string()).unwrap_or_default();
                 match result {
-                    IsduResult::Data(d) => *data = hex(d),
+                    IsduResult::Data(d) => *data = to_hex_lower(d),
                     IsduResult::Error(c) => *error = format!("{c:#06x}"),
                 }
             }

@@ -11,6 +11,7 @@ use drivespec_hpd::memory::ParamMap;
 use drivespec_hpd::model::{Drive, DriveConfig, Output};
 use drivespec_hpd::plc::PlcCodec;
 use drivespec_hpd::{Data, FrameRules, Message};
+use drivespec_spec::hex::{encode, Case};
 use drivespec_spec::Spec;
 
 /// 2024-01-02T10:00:00Z in µs since 1970: the start of generated recordings.
@@ -282,7 +283,7 @@ pub fn to_text(chunks: &[SerialChunk]) -> String {
         s.push_str(&format!(
             "{t} {} {}\n",
             dir_symbol(c.dir),
-            crate::report::hex(&c.bytes)
+            drivespec_spec::hex::to_hex(&c.bytes)
         ));
     }
     s
@@ -307,10 +308,7 @@ pub fn to_socat(chunks: &[SerialChunk]) -> String {
             c.bytes.len().saturating_sub(1)
         ));
         for line in c.bytes.chunks(16) {
-            let mut l = String::new();
-            for b in line {
-                l.push_str(&format!(" {b:02x}"));
-            }
+            let mut l = format!(" {}", encode(line, Case::Lower, " "));
             while l.len() < 49 {
                 l.push(' ');
             }

@@ -5,12 +5,12 @@ use super::cases::{status_bit, Action, PsdCase, Tolerance, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::cyclic::device::Device;
-use crate::cyclic::wire::hex;
 use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server};
 use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, Output, PkwRequest};
+use drivespec_spec::hex::to_hex_compact as hex;
 use drivespec_spec::FamilyId;
 
 /// A session on one device under test.

@@ -20,10 +20,6 @@ mod isdu {
     pub const STATUS: &str = "64";
     /// ISDU 67, actual position.
     pub const ACTUAL: &str = "67";
-    /// ISDU 129, upper limit.
-    pub const UPPER_LIMIT: &str = "129";
-    /// ISDU 130, lower limit.
-    pub const LOWER_LIMIT: &str = "130";
     /// ISDU 131, positioning window.
     pub const WINDOW: &str = "131";
     /// ISDU 134, loop direction.
@@ -1623,7 +1619,7 @@ impl<'a, 's> Gen<'a, 's> {
                 step(Role::Check, "until standstill", Self::until(false)),
             ],
         );
-        let upper = self.value(isdu::UPPER_LIMIT);
+        let upper = self.value(&self.rules.protocol().mapping.upper_limit_param);
         self.motion(
             "status/target-outside",
             &["PSX-STS-12-SET-1", "PSX-STS-12-RESET-1"],
@@ -1740,9 +1736,14 @@ impl<'a, 's> Gen<'a, 's> {
         );
         // Manual runs to narrowed end limits (ISDU 129 / 130): bits 14 and 15.
         let up = self.control("release-manual-run-larger");
+        let mapping = &self.rules.protocol().mapping;
+        let (upper_limit, lower_limit) = (
+            mapping.upper_limit_param.clone(),
+            mapping.lower_limit_param.clone(),
+        );
         for (limit, offset, word, bit, name) in [
-            (isdu::UPPER_LIMIT, 600i64, up, "14", "upper"),
-            (isdu::LOWER_LIMIT, -600, manual_down, "15", "lower"),
+            (upper_limit.as_str(), 600i64, up, "14", "upper"),
+            (lower_limit.as_str(), -600, manual_down, "15", "lower"),
         ] {
             let steps: Vec<StepDef> = [
                 self.write(Role::Setup, limit, start + offset),
@@ -2138,7 +2139,7 @@ impl<'a, 's> Gen<'a, 's> {
             "without IO-Link connection a held key jogs continuously",
             offline,
         );
-        let upper = self.value(isdu::UPPER_LIMIT);
+        let upper = self.value(&self.rules.protocol().mapping.upper_limit_param);
         let steps: Vec<StepDef> = [
             self.write(Role::Setup, isdu::LOOP_DIRECTION, 1),
             Some(step(

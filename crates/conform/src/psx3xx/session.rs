@@ -5,12 +5,12 @@ use super::cases::{Action, PsxCase, Tolerance};
 use super::Psx3xxSuite;
 use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
 use crate::cyclic::device::Device;
-use crate::cyclic::wire::hex;
 use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server};
 use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psx3xx::isdu::{ErrorType, Request as IsduRequest};
 use drivespec_psx3xx::{Input, Output};
+use drivespec_spec::hex::to_hex_compact as hex;
 use drivespec_spec::FamilyId;
 
 /// A session on one device under test.
@@ -179,7 +179,7 @@ impl<'a, 's> Psx3xxSession<'a, 's> {
             let digits = name
                 .strip_prefix("0x")
                 .or_else(|| name.strip_prefix("0X"))?;
-            u16::from_str_radix(digits, 16).ok().map(ErrorType)
+            drivespec_spec::hex::parse_hex_digits(digits).map(ErrorType)
         })
     }
 

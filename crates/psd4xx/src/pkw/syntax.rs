@@ -299,23 +299,10 @@ pub fn parse_number(text: &str) -> Result<i64, RequestError> {
 
 /// A decimal (optionally signed) or `0x` hexadecimal number.
 pub(crate) fn number(what: &'static str, text: &str) -> Result<i64, RequestError> {
-    let err = || RequestError::Number {
+    drivespec_spec::hex::parse_int(text).map_err(|_| RequestError::Number {
         what,
         found: text.to_owned(),
-    };
-    let t = text.trim().replace('_', "");
-    let (neg, body) = match t.strip_prefix('-') {
-        Some(rest) => (true, rest),
-        None => (false, t.strip_prefix('+').unwrap_or(&t)),
-    };
-    let magnitude = match body.strip_prefix("0x").or_else(|| body.strip_prefix("0X")) {
-        Some(hex) => i64::from_str_radix(hex, 16).map_err(|_| err())?,
-        None if body.chars().all(|c| c.is_ascii_digit()) && !body.is_empty() => {
-            body.parse::<i64>().map_err(|_| err())?
-        }
-        None => return Err(err()),
-    };
-    Ok(if neg { -magnitude } else { magnitude })
+    })
 }
 
 /// A mini-syntax text split at the verb.

@@ -32,12 +32,6 @@ const MAX_STEPS: usize = 40;
 /// Most cycles a wait for running or standstill takes.
 const WAIT_MAX: u32 = 1_500;
 
-/// ISDU 67, actual position (manual 3.1): where the runs start.
-const ACTUAL: &str = "67";
-/// ISDU 129, upper limit.
-const UPPER_LIMIT: &str = "129";
-/// ISDU 130, lower limit.
-const LOWER_LIMIT: &str = "130";
 /// ISDU 182, temperature limit (°C): the temperatures injected lie around it.
 const TEMPERATURE_LIMIT: &str = "182";
 /// ISDU 135, jog increment: the saved entry the save template changes.
@@ -389,9 +383,9 @@ impl<'s> PsxGen<'s> {
                 .div_ceil(cycle_us),
         )
         .unwrap_or(u32::MAX);
-        // ISDU 163: the wait before a held key turns into a manual run, in 5 ms steps.
+        // The wait before a held key turns into a manual run, in 5 ms steps (5.10).
         let wait_cycles = u32::try_from(
-            value("163")?
+            value(&protocol.jog.wait_param)?
                 .saturating_mul(5_000)
                 .div_euclid(cycle_as_i64(cycle_us)),
         )
@@ -401,8 +395,11 @@ impl<'s> PsxGen<'s> {
             formats: rules.outputs().iter().map(|o| o.format).collect(),
             default_format: rules.default_format(),
             commands: protocol.commands.commands.clone(),
-            start: value(ACTUAL)?,
-            limits: (value(LOWER_LIMIT)?, value(UPPER_LIMIT)?),
+            start: value(&protocol.mapping.actual_param)?,
+            limits: (
+                value(&protocol.mapping.lower_limit_param)?,
+                value(&protocol.mapping.upper_limit_param)?,
+            ),
             speed,
             save_cycles,
             key_cycles: (1, wait_cycles.saturating_add(10)),
