@@ -32,7 +32,13 @@ pub use files::SpecFiles;
 pub use parameter::{Access, DataType, EnumValue, ModeMeaning, Parameter, Resolved};
 pub use range::Ranges;
 pub use requirement::{Level, Requirement};
-pub use vector::{Vector, VectorKind, VectorResult};
+pub use vector::{
+    Body, BodyError, DirectParameterExpect, DirectParameterInput, FormulaExpect, FormulaInput,
+    HpdFrameExpect, HpdFrameInput, HpdPlcBytesExpect, HpdPlcBytesInput, HpdPlcExpect, HpdPlcInput,
+    IntOrText, IsduExpect, IsduInput, Number, OneOrMany, PkwExpect, PkwInput, PositionExpect,
+    PositionInput, ProcessImageExpect, ProcessImageInput, RecordExpect, RecordInput,
+    TimestampExpect, TimestampInput, Vector, VectorBody, VectorKind, VectorResult,
+};
 
 use std::path::Path;
 

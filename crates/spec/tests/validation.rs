@@ -487,27 +487,52 @@ fn every_problem_is_reported_not_just_the_first() {
     assert_eq!(problems_with("psd4xx/test.toml", &bad).len(), 2);
 }
 
-#[test]
-fn vector_needs_its_kinds_input_keys() {
+/// Loads the skeleton with `REQ` and `vector` as `psd4xx/vectors/test.toml`.
+fn vector_problems(vector: &str) -> Vec<String> {
     let mut files = skeleton();
     files.set("psd4xx/test.toml", REQ);
-    files.set(
-        "psd4xx/vectors/test.toml",
-        &VECTOR.replace(
-            "ak = 1\npnu = 44\n[vector.expect]",
-            "pnu = 44\n[vector.expect]",
-        ),
-    );
-    let problems: Vec<String> = match Spec::from_files(&files) {
+    files.set("psd4xx/vectors/test.toml", vector);
+    match Spec::from_files(&files) {
         Ok(_) => Vec::new(),
         Err(e) => e.0.iter().map(ToString::to_string).collect(),
-    };
+    }
+}
+
+#[test]
+fn vector_needs_its_kinds_input_keys() {
+    let problems = vector_problems(&VECTOR.replace(
+        "ak = 1\npnu = 44\n[vector.expect]",
+        "pnu = 44\n[vector.expect]",
+    ));
     assert_eq!(
         problems,
         vec![
-            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": a pkw vector needs input key `ak`"#
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": input: missing field `ak`"#
                 .to_owned()
         ]
+    );
+}
+
+#[test]
+fn vector_key_must_be_known_to_its_kind() {
+    let problems = vector_problems(&VECTOR.replace("pwe = 2", "pwe_value = 2"));
+    assert_eq!(problems.len(), 1, "{problems:#?}");
+    assert!(
+        problems[0].starts_with(
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": expect: unknown field `pwe_value`, expected one of"#
+        ),
+        "{problems:#?}"
+    );
+}
+
+#[test]
+fn vector_value_must_have_its_keys_type() {
+    let problems = vector_problems(&VECTOR.replace("pnu = 44", "pnu = \"44\""));
+    assert_eq!(problems.len(), 1, "{problems:#?}");
+    assert!(
+        problems[0]
+            .starts_with(r#"psd4xx/vectors/test.toml: vector "pkw-read-44": input: invalid type"#),
+        "{problems:#?}"
     );
 }
 
@@ -516,11 +541,8 @@ fn vector_parameters_must_exist() {
     let mut files = skeleton();
     files.set("psd4xx/test.toml", &format!("{PARAM}{REQ}"));
     let v = VECTOR
-        .replace("pnu = 44\n", "pnu = 44\nparam = \"45\"\n")
-        .replace(
-            "pwe = 2\n",
-            "pwe = 2\nparams = { \"44\" = 2, \"46\" = 1 }\n",
-        );
+        .replace("pnu = 44\n", "pnu = 44\nstate = { \"45\" = 1 }\n")
+        .replace("pwe = 2\n", "pwe = 2\nstate = { \"44\" = 2, \"46\" = 1 }\n");
     files.set("psd4xx/vectors/test.toml", &v);
     let problems: Vec<String> = match Spec::from_files(&files) {
         Ok(_) => Vec::new(),
