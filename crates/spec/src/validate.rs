@@ -137,6 +137,24 @@ impl Validator<'_> {
         let f = self.family;
         for p in &f.parameters {
             let rec = rec_p(p);
+            let conflicts = [
+                (
+                    p.range_model && p.range.is_some(),
+                    "a range here and range_model: the models give the range",
+                ),
+                (
+                    p.model_max.is_some() && !p.range_model,
+                    "model_max without range_model",
+                ),
+                (
+                    p.model_default.is_some() && !p.default_model,
+                    "model_default without default_model",
+                ),
+            ];
+            for (_, message) in conflicts.iter().filter(|c| c.0) {
+                let message = (*message).to_owned();
+                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message });
+            }
             if let (Some(range), Some((lo, hi))) = (&p.range, p.data_type.bounds()) {
                 for [min, max] in range.intervals() {
                     if min > max {
