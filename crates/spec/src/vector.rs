@@ -182,29 +182,29 @@ fn typed<T: serde::de::DeserializeOwned>(
 #[serde(untagged)]
 pub enum VectorBody {
     /// An HPD serial request and the drive's answer.
-    HpdFrame(Body<HpdFrameInput, HpdFrameExpect>),
+    HpdFrame(Box<Body<HpdFrameInput, HpdFrameExpect>>),
     /// An HPD PLC program run on given parameters.
-    HpdPlc(Body<HpdPlcInput, HpdPlcExpect>),
+    HpdPlc(Box<Body<HpdPlcInput, HpdPlcExpect>>),
     /// An HPD PLC listing and its bytes.
-    HpdPlcBytes(Body<HpdPlcBytesInput, HpdPlcBytesExpect>),
+    HpdPlcBytes(Box<Body<HpdPlcBytesInput, HpdPlcBytesExpect>>),
     /// A formula from the manual with inputs and outputs.
-    Formula(Body<FormulaInput, FormulaExpect>),
+    Formula(Box<Body<FormulaInput, FormulaExpect>>),
     /// A PSD PKW command and response.
-    Pkw(Body<PkwInput, PkwExpect>),
+    Pkw(Box<Body<PkwInput, PkwExpect>>),
     /// A process image and its fields.
-    ProcessImage(Body<ProcessImageInput, ProcessImageExpect>),
+    ProcessImage(Box<Body<ProcessImageInput, ProcessImageExpect>>),
     /// An acyclic record read or write.
-    Record(Body<RecordInput, RecordExpect>),
+    Record(Box<Body<RecordInput, RecordExpect>>),
     /// An IO-Link ISDU request and response.
-    Isdu(Body<IsduInput, IsduExpect>),
+    Isdu(Box<Body<IsduInput, IsduExpect>>),
     /// A PSx time stamp and its effect.
-    Timestamp(Body<TimestampInput, TimestampExpect>),
+    Timestamp(Box<Body<TimestampInput, TimestampExpect>>),
     /// Position arithmetic (scaling, mapping end, limits).
-    Position(Body<PositionInput, PositionExpect>),
+    Position(Box<Body<PositionInput, PositionExpect>>),
     /// IO-Link Direct Parameter page 1.
-    DirectParameter(Body<DirectParameterInput, DirectParameterExpect>),
+    DirectParameter(Box<Body<DirectParameterInput, DirectParameterExpect>>),
     /// A sequence of process-data steps.
-    Sequence(Body<toml::Table, toml::Table>),
+    Sequence(Box<Body<toml::Table, toml::Table>>),
 }
 
 impl VectorBody {
@@ -215,18 +215,24 @@ impl VectorBody {
         expect: toml::Table,
     ) -> Result<VectorBody, BodyError> {
         Ok(match kind {
-            VectorKind::HpdFrame => VectorBody::HpdFrame(Body::parse(input, expect)?),
-            VectorKind::HpdPlc => VectorBody::HpdPlc(Body::parse(input, expect)?),
-            VectorKind::HpdPlcBytes => VectorBody::HpdPlcBytes(Body::parse(input, expect)?),
-            VectorKind::Formula => VectorBody::Formula(Body::parse(input, expect)?),
-            VectorKind::Pkw => VectorBody::Pkw(Body::parse(input, expect)?),
-            VectorKind::ProcessImage => VectorBody::ProcessImage(Body::parse(input, expect)?),
-            VectorKind::Record => VectorBody::Record(Body::parse(input, expect)?),
-            VectorKind::Isdu => VectorBody::Isdu(Body::parse(input, expect)?),
-            VectorKind::Timestamp => VectorBody::Timestamp(Body::parse(input, expect)?),
-            VectorKind::Position => VectorBody::Position(Body::parse(input, expect)?),
-            VectorKind::DirectParameter => VectorBody::DirectParameter(Body::parse(input, expect)?),
-            VectorKind::Sequence => VectorBody::Sequence(Body { input, expect }),
+            VectorKind::HpdFrame => VectorBody::HpdFrame(Box::new(Body::parse(input, expect)?)),
+            VectorKind::HpdPlc => VectorBody::HpdPlc(Box::new(Body::parse(input, expect)?)),
+            VectorKind::HpdPlcBytes => {
+                VectorBody::HpdPlcBytes(Box::new(Body::parse(input, expect)?))
+            }
+            VectorKind::Formula => VectorBody::Formula(Box::new(Body::parse(input, expect)?)),
+            VectorKind::Pkw => VectorBody::Pkw(Box::new(Body::parse(input, expect)?)),
+            VectorKind::ProcessImage => {
+                VectorBody::ProcessImage(Box::new(Body::parse(input, expect)?))
+            }
+            VectorKind::Record => VectorBody::Record(Box::new(Body::parse(input, expect)?)),
+            VectorKind::Isdu => VectorBody::Isdu(Box::new(Body::parse(input, expect)?)),
+            VectorKind::Timestamp => VectorBody::Timestamp(Box::new(Body::parse(input, expect)?)),
+            VectorKind::Position => VectorBody::Position(Box::new(Body::parse(input, expect)?)),
+            VectorKind::DirectParameter => {
+                VectorBody::DirectParameter(Box::new(Body::parse(input, expect)?))
+            }
+            VectorKind::Sequence => VectorBody::Sequence(Box::new(Body { input, expect })),
         })
     }
 
