@@ -681,10 +681,11 @@ fn examples(family: &Family, format: Format) -> Result<String> {
             v.source,
             v.description
         );
-        for (k, val) in &v.input {
+        let (input, expect) = v.body.tables();
+        for (k, val) in &input {
             let _ = writeln!(s, "    in   {k} = {}", inline(val));
         }
-        for (k, val) in &v.expect {
+        for (k, val) in &expect {
             let _ = writeln!(s, "    out  {k} = {}", inline(val));
         }
     }

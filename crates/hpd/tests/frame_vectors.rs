@@ -11,10 +11,6 @@ use drivespec_hpd::{parse, FrameRules, Message};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{FamilyId, Spec, VectorKind, VectorResult};
 
-fn int(v: &drivespec_spec::Vector, key: &str) -> Option<i64> {
-    v.input(key).and_then(toml::Value::as_integer)
-}
-
 #[test]
 fn manual_examples_decode_and_encode_byte_exact() {
     let spec = Spec::builtin().unwrap();
@@ -31,7 +27,8 @@ fn manual_examples_decode_and_encode_byte_exact() {
         vectors.len()
     );
     for v in vectors {
-        let request = parse_hex(v.input("request").and_then(|x| x.as_str()).unwrap()).unwrap();
+        let b = v.hpd_frame().unwrap();
+        let request = parse_hex(&b.input.request).unwrap();
         if v.result == VectorResult::Invalid {
             assert!(
                 parse(&rules, &request).is_err(),
@@ -39,7 +36,7 @@ fn manual_examples_decode_and_encode_byte_exact() {
                 v.id
             );
             assert!(
-                v.expected("response").is_none(),
+                b.expect.response.is_none(),
                 "{}: nothing answers an invalid frame",
                 v.id
             );
@@ -52,13 +49,8 @@ fn manual_examples_decode_and_encode_byte_exact() {
             "{}: re-encoding",
             v.id
         );
-        assert_eq!(
-            Some(i64::from(msg.addr())),
-            int(v, "addr"),
-            "{}: addr",
-            v.id
-        );
-        if let Some(cmd) = int(v, "cmd") {
+        assert_eq!(Some(i64::from(msg.addr())), b.input.addr, "{}: addr", v.id);
+        if let Some(cmd) = b.input.cmd {
             assert_eq!(i64::from(rules.code(msg.kind())), cmd, "{}: cmd", v.id);
         }
         let (lun, par) = match msg {
@@ -69,9 +61,9 @@ fn manual_examples_decode_and_encode_byte_exact() {
             Message::BitChange { par, .. } => (rules.bit_change_lun, par),
             other => panic!("{}: a request, not {other:?}", v.id),
         };
-        assert_eq!(Some(i64::from(lun)), int(v, "lun"), "{}: lun", v.id);
-        assert_eq!(Some(i64::from(par)), int(v, "par"), "{}: par", v.id);
-        match v.expected("response").and_then(|x| x.as_str()) {
+        assert_eq!(Some(i64::from(lun)), b.input.lun, "{}: lun", v.id);
+        assert_eq!(Some(i64::from(par)), b.input.par, "{}: par", v.id);
+        match &b.expect.response {
             Some(hex) => {
                 let response = parse_hex(hex).unwrap();
                 let answer =
@@ -89,17 +81,18 @@ fn manual_examples_decode_and_encode_byte_exact() {
                     "{}: response re-encoding",
                     v.id
                 );
-                if let (Some(want), Some(name), Message::Response { data, .. }) = (
-                    v.expected("value").and_then(toml::Value::as_integer),
-                    v.input("param").and_then(|x| x.as_str()),
-                    answer,
-                ) {
+                if let (Some(want), Some(name), Message::Response { data, .. }) =
+                    (b.expect.value, b.input.param.as_deref(), answer)
+                {
                     let target = Target::parse(family, name).unwrap();
                     assert_eq!(target.value(&data), want, "{}: value of {name}", v.id);
                 }
             }
             None => {
-                let foreign = int(v, "drive_addr").is_some_and(|d| d != i64::from(msg.addr()));
+                let foreign = b
+                    .input
+                    .drive_addr
+                    .is_some_and(|d| d != i64::from(msg.addr()));
                 assert!(
                     foreign || msg.kind() == drivespec_hpd::MessageKind::Broadcast,
                     "{}: only broadcasts and other drives' messages go unanswered",

@@ -13,16 +13,8 @@ mod model_util;
 use drivespec_hpd::model::{Drive, DriveConfig};
 use drivespec_hpd::{parse, Message};
 use drivespec_spec::hex::parse_hex;
-use drivespec_spec::{Vector, VectorKind};
+use drivespec_spec::VectorKind;
 use model_util::*;
-
-fn int(v: &Vector, key: &str) -> Option<i64> {
-    v.input(key).and_then(toml::Value::as_integer)
-}
-
-fn text<'v>(v: &'v Vector, key: &str) -> Option<&'v str> {
-    v.input(key).and_then(|x| x.as_str())
-}
 
 /// Whether bit `name` (`b99.14`) is a command the drive executes (bits.toml rules).
 fn is_command(name: &str) -> bool {
@@ -46,16 +38,14 @@ fn serial_vectors_run_against_the_model() {
         if v.id.starts_with("serial-case-") {
             cases += 1;
         }
-        let at = int(v, "drive_addr").or(int(v, "addr")).unwrap();
+        let b = v.hpd_frame().unwrap();
+        let at = b.input.drive_addr.or(b.input.addr).unwrap();
         let mut d = Drive::new(spec(), DriveConfig::commissioned(u8::try_from(at).unwrap()))
             .unwrap_or_else(|e| panic!("{}: {e}", v.id));
-        let request = parse_hex(text(v, "request").unwrap()).unwrap();
+        let request = parse_hex(&b.input.request).unwrap();
         let msg = parse(&rules, &request).ok();
-        let name = text(v, "param").or(text(v, "target"));
-        let want = v
-            .expected("value")
-            .or(v.input("value"))
-            .and_then(toml::Value::as_integer);
+        let name = b.input.param.as_deref().or(b.input.target.as_deref());
+        let want = b.expect.value.or(b.input.value);
         // What the example reads is put into the drive first (Pr7 is a measurement).
         if let (Some(Message::ReadParam { .. }), Some(name), Some(want)) = (msg, name, want) {
             set(&mut d, 0, name, want);
@@ -69,7 +59,7 @@ fn serial_vectors_run_against_the_model() {
         // Let the time-out of a half-received frame pass too.
         d.advance(1_000 + 600_000);
         let sent = transmits(&drain(&mut d));
-        match v.expected("response").and_then(|x| x.as_str()) {
+        match &b.expect.response {
             Some(hex) => assert_eq!(sent, [parse_hex(hex).unwrap()], "{}", v.id),
             None => assert!(sent.is_empty(), "{}: the drive must stay silent", v.id),
         }

@@ -11,23 +11,16 @@ use drivespec_hpd::memory::{Memory, ParamMap};
 use drivespec_hpd::plc::{PlcCodec, PlcRuntime, PlcState};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{FamilyId, Readings, Spec, VectorKind};
+use std::collections::BTreeMap;
 
-fn lines(v: &toml::Value) -> String {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|l| format!("{}\n", l.as_str().unwrap()))
-        .collect()
+fn lines(v: &[String]) -> String {
+    v.iter().map(|l| format!("{l}\n")).collect()
 }
 
-fn table(v: Option<&toml::Value>) -> Vec<(String, i64)> {
-    v.and_then(|t| t.as_table())
-        .map(|t| {
-            t.iter()
-                .map(|(k, v)| (k.clone(), v.as_integer().unwrap()))
-                .collect()
-        })
-        .unwrap_or_default()
+fn table(v: &Option<BTreeMap<String, i64>>) -> Vec<(String, i64)> {
+    v.iter()
+        .flat_map(|t| t.iter().map(|(k, v)| (k.clone(), *v)))
+        .collect()
 }
 
 #[test]
@@ -42,11 +35,12 @@ fn listings_encode_to_the_manual_bytes_and_back() {
         .collect();
     assert!(vectors.len() >= 2, "cases 7 and 8 of 4.1 at least");
     for v in vectors {
+        let body = v.hpd_plc_bytes().unwrap();
         let program = codec
-            .parse_listing(&lines(v.input("listing").unwrap()))
+            .parse_listing(&lines(&body.input.listing))
             .unwrap_or_else(|e| panic!("{}: {e}", v.id));
         let bytes = codec.encode_program(&program).unwrap();
-        let want = parse_hex(v.expected("bytes").unwrap().as_str().unwrap()).unwrap();
+        let want = parse_hex(body.expect.bytes.as_deref().unwrap()).unwrap();
         assert_eq!(bytes, want, "{}", v.id);
         // Back from bytes: the same instructions, listed the same way.
         let mut at = 0;
@@ -93,17 +87,18 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
         "ADD, ADD with and without b94.0, DIV, timer at least"
     );
     for v in vectors {
+        let body = v.hpd_plc().unwrap();
         let mut mem = Memory::default();
         let b = map.bit(run_bit.0, run_bit.1).unwrap();
         mem.set_bit(b, true);
         let mut inputs = 0u16;
-        for (name, value) in table(v.input("params")) {
+        for (name, value) in table(&body.input.params) {
             let slot = map
                 .slot(ParamMap::parse_param(&name).unwrap())
                 .unwrap_or_else(|| panic!("{}: {name} has no slot", v.id));
             mem.set(slot.addr, slot.size, value as u32);
         }
-        for (name, value) in table(v.input("bits")) {
+        for (name, value) in table(&body.input.bits) {
             let (n, y) = ParamMap::parse_bit(&name).unwrap();
             mem.set_bit(map.bit(n, y).unwrap(), value == 1);
             if name.starts_with("b90.") && y < 8 && value == 1 {
@@ -111,9 +106,9 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
             }
         }
         let program = codec
-            .parse_listing(&lines(v.input("program").unwrap()))
+            .parse_listing(&lines(&body.input.program))
             .unwrap_or_else(|e| panic!("{}: {e}", v.id));
-        let scans = v.input("scans").and_then(|s| s.as_integer()).unwrap_or(1);
+        let scans = body.input.scans.unwrap_or(1);
         let mut state = PlcState::default();
         // One scan period holds scan_us / fin_period_us FIN copy slots (3.8.1).
         let fin_per_scan = runtime.scan_us() / runtime.fin_period_us();
@@ -123,7 +118,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
             }
             runtime.scan(&mut state, &mut mem, &program, inputs);
         }
-        for (name, want) in table(v.expected("params")) {
+        for (name, want) in table(&body.expect.params) {
             let slot = map.slot(ParamMap::parse_param(&name).unwrap()).unwrap();
             assert_eq!(
                 i64::from(mem.get_signed(slot.addr, slot.size)),
@@ -132,7 +127,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
                 v.id
             );
         }
-        for (name, want) in table(v.expected("bits")) {
+        for (name, want) in table(&body.expect.bits) {
             let (n, y) = ParamMap::parse_bit(&name).unwrap();
             assert_eq!(
                 mem.bit(map.bit(n, y).unwrap()),
@@ -141,7 +136,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
                 v.id
             );
         }
-        for (name, want) in table(v.expected("dwords")) {
+        for (name, want) in table(&body.expect.dwords) {
             let (lo, _) = name.split_once(':').unwrap();
             let slot = map.slot(ParamMap::parse_param(lo).unwrap()).unwrap();
             assert_eq!(
@@ -151,10 +146,7 @@ fn arithmetic_logic_and_timer_examples_give_the_manual_results() {
                 v.id
             );
         }
-        if let Some(ms) = v
-            .expected("elapsed_ms")
-            .and_then(|x| x.as_float().or(x.as_integer().map(|i| i as f64)))
-        {
+        if let Some(ms) = body.expect.elapsed_ms {
             let elapsed = scans as f64 * f64::from(runtime.scan_us()) / 1000.0;
             assert!(
                 (elapsed - ms).abs() < 0.5,

@@ -14,55 +14,44 @@ mod model_util;
 
 use drivespec_positioner::axis::spindle_factors;
 use drivespec_psd4xx::model::DriveConfig;
-use drivespec_spec::{Vector, VectorKind, VectorResult};
+use drivespec_spec::{IntOrText, Number, Vector, VectorKind, VectorResult};
 use model_util::*;
 
 const DEFAULT_MODEL: &str = "PSD401-5V";
 
-fn get(t: &toml::Table, key: &str) -> Option<f64> {
-    t.get(key)
-        .and_then(|v| v.as_integer().map(|i| i as f64).or_else(|| v.as_float()))
-}
-
 /// Computes every expected key of a position vector; returns (key, expected, computed).
 fn evaluate(v: &Vector) -> Vec<(String, f64, f64)> {
-    let input = &v.input;
+    let input = &v.position().unwrap().input;
     let model = v.model.as_deref().unwrap_or(DEFAULT_MODEL);
-    let pos = get(input, "position")
-        .or(get(input, "actual"))
-        .unwrap_or(0.0) as i64;
+    let pos = input.position.or(input.actual).unwrap_or(0);
     let mut s = Sim::with(DriveConfig::new(model).with_start_position(pos));
     // 4.8 table: the factors of a spindle pitch and resolution.
-    let spindle = match (get(input, "pitch_um"), get(input, "resolution_um")) {
-        (Some(p), Some(r)) => spindle_factors(400, p as i64, r as i64),
+    let spindle = match (input.pitch_um, input.resolution_um) {
+        (Some(p), Some(r)) => spindle_factors(400, p, r),
         _ => None,
     };
-    let num = get(input, "numerator")
-        .map(|x| x as i64)
-        .or(spindle.map(|f| f.0));
-    let den = get(input, "denominator")
-        .map(|x| x as i64)
-        .or(spindle.map(|f| f.1));
+    let num = input.numerator.or(spindle.map(|f| f.0));
+    let den = input.denominator.or(spindle.map(|f| f.1));
     if let (Some(n), Some(d)) = (num, den) {
         // 4.7 note 7: scaling first. PSD-MAP-014 recalculates the delivery values.
         s.write(38, n);
         s.write(39, d);
     }
-    if let Some(r) = get(input, "reference").filter(|r| *r != 0.0) {
-        s.write(40, r as i64);
+    if let Some(r) = input.reference.filter(|r| *r != 0) {
+        s.write(40, r);
     }
     let mut accepted = true;
-    if let Some(dir) = input.get("direction").and_then(toml::Value::as_str) {
+    if let Some(IntOrText::Text(dir)) = &input.direction {
         // PSD-MAP-007: the window of par. 41 around the actual position.
         let (lo, hi) = s.drive.core().axis().mapping_end_window(s.actual());
         s.write(41, if dir == "up" { hi } else { lo });
-    } else if let Some(end) = get(input, "mapping_end").map(|x| x as i64) {
+    } else if let Some(end) = input.mapping_end {
         if end != s.par(41) {
             accepted = s.try_write(41, end).is_ok();
         }
     }
-    if let Some(w) = get(input, "write_actual") {
-        s.write(3, w as i64);
+    if let Some(w) = input.write_actual {
+        s.write(3, w);
     }
     let axis = s.drive.core().axis().clone();
     let ipr = axis.increments_per_rotation();
@@ -70,7 +59,8 @@ fn evaluate(v: &Vector) -> Vec<(String, f64, f64)> {
     let (lo, hi) = axis.position_range();
     let (end_min, end_max) = axis.mapping_end_window(s.actual());
     let mut out = Vec::new();
-    for (key, value) in &v.expect {
+    let (_, expect) = v.body.tables();
+    for (key, value) in &expect {
         let want = value
             .as_integer()
             .map(|i| i as f64)
@@ -118,7 +108,8 @@ fn every_position_vector_comes_out_exactly() {
     for v in list {
         let results = evaluate(v);
         let holds = |(_, want, got): &(String, f64, f64)| (want - got).abs() < 1e-9;
-        let must_hold = v.result == VectorResult::Valid || v.expect.contains_key("accepted");
+        let must_hold = v.result == VectorResult::Valid
+            || v.position().is_some_and(|b| b.expect.accepted.is_some());
         if must_hold {
             for r in &results {
                 assert!(
@@ -144,18 +135,20 @@ fn every_position_vector_comes_out_exactly() {
 
 #[test]
 fn increments_per_rotation_formula_vectors() {
-    for v in family().vectors.iter().filter(|v| {
-        v.kind == VectorKind::Formula
-            && v.input("formula").and_then(toml::Value::as_str) == Some("increments-per-rotation")
-    }) {
-        let n = get(&v.input, "numerator").unwrap() as i64;
-        let d = get(&v.input, "denominator").unwrap() as i64;
+    for (v, b) in family()
+        .vectors
+        .iter()
+        .filter_map(|v| Some((v, v.formula()?)))
+        .filter(|(_, b)| b.input.formula == "increments-per-rotation")
+    {
+        let n = b.input.numerator.unwrap();
+        let d = b.input.denominator.unwrap();
         let mut s = Sim::new(DEFAULT_MODEL);
         s.write(38, n);
         s.write(39, d);
         let ipr = s.drive.core().axis().increments_per_rotation();
-        let want = get(&v.expect, "increments_per_rotation").unwrap();
-        let tol = get(&v.expect, "tolerance").unwrap_or(1e-9);
+        let want = b.expect.increments_per_rotation.unwrap().as_f64();
+        let tol = b.expect.tolerance.map_or(1e-9, Number::as_f64);
         assert!((ipr - want).abs() <= tol, "{}: {ipr} vs {want}", v.id);
     }
 }

@@ -15,8 +15,9 @@ use drivespec_positioner::EnvChange;
 use drivespec_psd4xx::model::{DriveConfig, LinkEvent, RecordAnswer, RecordRequest};
 use drivespec_psd4xx::{Output, Pkw, PkwRequest, PkwResponse};
 use drivespec_spec::hex::parse_hex;
-use drivespec_spec::{Vector, VectorKind, VectorResult};
+use drivespec_spec::{IntOrText, Vector, VectorKind, VectorResult};
 use model_util::*;
+use std::collections::BTreeMap;
 
 /// The model the vectors assume when they name none: limits ±805,200 at delivery (an
 /// ungeared PSD4xx, 3.4).
@@ -39,21 +40,14 @@ fn ints(t: &toml::Table, key: &str) -> Vec<u32> {
 
 /// A drive set up with a vector's `state`: "3" places the shaft, "13" names the model string,
 /// everything else is written as a parameter.
-fn setup(v: &Vector) -> Sim {
+fn setup(v: &Vector, state: Option<&BTreeMap<String, IntOrText>>) -> Sim {
     let model = v.model.as_deref().unwrap_or(DEFAULT_MODEL);
-    let state = v.input("state").and_then(toml::Value::as_table);
     let mut config = DriveConfig::new(model);
-    if let Some(p) = state
-        .and_then(|s| s.get("3"))
-        .and_then(toml::Value::as_integer)
-    {
-        config = config.with_start_position(p);
+    if let Some(IntOrText::Int(p)) = state.and_then(|s| s.get("3")) {
+        config = config.with_start_position(*p);
     }
-    if let Some(t) = state
-        .and_then(|s| s.get("13"))
-        .and_then(toml::Value::as_str)
-    {
-        config.model_string = Some(t.to_owned());
+    if let Some(IntOrText::Text(t)) = state.and_then(|s| s.get("13")) {
+        config.model_string = Some(t.clone());
     }
     let mut s = Sim::with(config);
     if let Some(state) = state {
@@ -61,12 +55,15 @@ fn setup(v: &Vector) -> Sim {
         let mut keys: Vec<&String> = state.keys().collect();
         keys.sort_by_key(|k| (k.as_str() != "41", k.parse::<u32>().unwrap_or(0)));
         for k in keys {
-            let value = &state[k];
+            let value = match &state[k] {
+                IntOrText::Int(i) => *i,
+                IntOrText::Text(t) => panic!("{}: par {k} = {t:?} is not a number", v.id),
+            };
             match k.as_str() {
                 "3" | "13" => {}
-                "1" => reach_status(&mut s, int(value)),
-                "2" => reach_speed(&mut s, int(value)),
-                _ => s.write(k.parse().unwrap(), int(value)),
+                "1" => reach_status(&mut s, value),
+                "2" => reach_speed(&mut s, value),
+                _ => s.write(k.parse().unwrap(), value),
             }
         }
     }
@@ -101,9 +98,18 @@ fn reach_speed(s: &mut Sim, rpm: i64) {
 
 fn run_sequence(v: &Vector) {
     let id = &v.id;
-    let mut s = setup(v);
+    let body = v.sequence().unwrap();
+    let state: Option<BTreeMap<String, IntOrText>> = body
+        .input
+        .get("state")
+        .map(|t| t.clone().try_into().unwrap());
+    let mut s = setup(v, state.as_ref());
     let window = s.par(44);
-    let steps = v.input("steps").and_then(toml::Value::as_array).unwrap();
+    let steps = body
+        .input
+        .get("steps")
+        .and_then(toml::Value::as_array)
+        .unwrap();
     for (n, step) in steps.iter().enumerate() {
         let step = step.as_table().unwrap();
         let at = |s: &Sim, what: &str| format!("{id} step {n}: {what}; {}", s.describe());
@@ -207,7 +213,7 @@ fn run_sequence(v: &Vector) {
             assert!(!dropped, "{}", at(&s, "the drive stopped in between"));
         }
     }
-    if let Some(a) = v.expected("actual") {
+    if let Some(a) = body.expect.get("actual") {
         assert!(
             s.actual().abs_diff(int(a)) <= window as u64,
             "{id}: final actual"
@@ -225,13 +231,10 @@ fn every_sequence_vector_runs_on_the_model() {
     }
 }
 
-fn state_matches(s: &Sim, id: &str, expect: Option<&toml::Value>) {
-    let Some(state) = expect.and_then(toml::Value::as_table) else {
-        return;
-    };
-    for (k, v) in state {
+fn state_matches(s: &Sim, id: &str, expect: &Option<BTreeMap<String, i64>>) {
+    for (k, v) in expect.iter().flatten() {
         let pnu: u16 = k.parse().unwrap();
-        assert_eq!(s.par(pnu), int(v), "{id}: par {k} after");
+        assert_eq!(s.par(pnu), *v, "{id}: par {k} after");
     }
 }
 
@@ -242,13 +245,14 @@ fn every_record_vector_runs_on_the_model() {
     assert!(!list.is_empty());
     for v in list {
         let id = &v.id;
-        let mut s = setup(v);
-        let index = u16::try_from(int(v.input("index").unwrap())).unwrap();
-        let req = match v.input("op").and_then(toml::Value::as_str) {
-            Some("read") => RecordRequest::Read { index },
-            Some("write") => RecordRequest::Write {
+        let b = v.record().unwrap();
+        let mut s = setup(v, b.input.state.as_ref());
+        let index = u16::try_from(b.input.index).unwrap();
+        let req = match b.input.op.as_str() {
+            "read" => RecordRequest::Read { index },
+            "write" => RecordRequest::Write {
                 index,
-                data: parse_hex(v.input("data").and_then(toml::Value::as_str).unwrap()).unwrap(),
+                data: parse_hex(b.input.data.as_deref().unwrap()).unwrap(),
             },
             other => panic!("{id}: op {other:?}"),
         };
@@ -256,19 +260,19 @@ fn every_record_vector_runs_on_the_model() {
             .record(req)
             .result
             .unwrap_or_else(|e| panic!("{id}: {e:?}"));
-        match (&answer, v.expected("data").and_then(toml::Value::as_str)) {
+        match (&answer, b.expect.data.as_deref()) {
             (RecordAnswer::Data { bytes }, Some(hex)) => {
                 assert_eq!(bytes, &parse_hex(hex).unwrap(), "{id}: data")
             }
             (RecordAnswer::Written | RecordAnswer::Ignored, Some("")) => {}
             (RecordAnswer::Data { bytes }, None) => {
-                let text = v.expected("text").and_then(toml::Value::as_str).unwrap();
+                let text = b.expect.text.as_deref().unwrap();
                 let until_nul: Vec<u8> = bytes.iter().copied().take_while(|b| *b != 0).collect();
                 assert_eq!(until_nul, text.as_bytes(), "{id}: text");
             }
             other => panic!("{id}: {other:?}"),
         }
-        state_matches(&s, id, v.expected("state"));
+        state_matches(&s, id, &b.expect.state);
     }
 }
 
@@ -281,9 +285,10 @@ fn every_pkw_vector_runs_on_the_model() {
     assert!(list.len() >= 25);
     for v in list {
         let id = &v.id;
-        let mut s = setup(v);
+        let b = v.pkw().unwrap();
+        let mut s = setup(v, b.input.state.as_ref());
         let rules = s.rules().clone();
-        let req_bytes = parse_hex(v.input("bytes").and_then(toml::Value::as_str).unwrap()).unwrap();
+        let req_bytes = parse_hex(b.input.bytes.as_deref().unwrap()).unwrap();
         let req: PkwRequest = Pkw::parse(rules.pkw(), &req_bytes).unwrap();
         // A fresh command: the controller sends "no command" first (PSD-PKW-005).
         let out = Output {
@@ -294,9 +299,9 @@ fn every_pkw_vector_runs_on_the_model() {
         s.drive.handle_output(s.now, &out);
         s.drive.handle_output(s.now, &Output { pkw: req, ..out });
         let (_, input) = std::iter::from_fn(|| s.drive.poll_input()).last().unwrap();
-        let want = parse_hex(v.expected("bytes").and_then(toml::Value::as_str).unwrap()).unwrap();
+        let want = parse_hex(b.expect.bytes.as_deref().unwrap()).unwrap();
         let got: PkwResponse = input.pkw;
         assert_eq!(got.to_bytes(rules.pkw()).unwrap(), want, "{id}: response");
-        state_matches(&s, id, v.expected("state"));
+        state_matches(&s, id, &b.expect.state);
     }
 }

@@ -13,7 +13,7 @@ use drivespec_psd4xx::{
     PkwRequest, PkwResponse, RecordRead, RecordValue, RecordWrite, Reply, Request, Rules, Verdict,
 };
 use drivespec_spec::hex::parse_hex;
-use drivespec_spec::{FamilyId, Spec, Vector, VectorKind};
+use drivespec_spec::{FamilyId, IntOrText, Spec, Vector, VectorKind};
 use std::sync::OnceLock;
 
 fn spec() -> &'static Spec {
@@ -34,28 +34,22 @@ fn vectors(kind: VectorKind) -> Vec<&'static Vector> {
         .collect()
 }
 
-fn int(t: &toml::Table, key: &str) -> Option<i64> {
-    t.get(key).and_then(toml::Value::as_integer)
+fn bytes(hex: &Option<String>) -> Option<Vec<u8>> {
+    hex.as_deref().map(|h| parse_hex(h).unwrap())
 }
 
-fn bytes(t: &toml::Table, key: &str) -> Option<Vec<u8>> {
-    t.get(key)
-        .and_then(|v| v.as_str())
-        .map(|h| parse_hex(h).unwrap())
-}
+/// A PKW block's AK, PNU, IND and PWE as a vector gives them.
+type Fields = [Option<i64>; 4];
 
-fn check_fields<C>(id: &str, side: &str, pkw: &drivespec_psd4xx::Pkw<C>, t: &toml::Table)
+fn check_fields<C>(id: &str, side: &str, pkw: &drivespec_psd4xx::Pkw<C>, want: Fields)
 where
     C: Copy + Into<u8>,
 {
-    assert_eq!(
-        Some(i64::from(pkw.ak.into())),
-        int(t, "ak"),
-        "{id} {side}: ak"
-    );
-    assert_eq!(Some(i64::from(pkw.pnu)), int(t, "pnu"), "{id} {side}: pnu");
-    assert_eq!(Some(i64::from(pkw.ind)), int(t, "ind"), "{id} {side}: ind");
-    assert_eq!(Some(i64::from(pkw.pwe)), int(t, "pwe"), "{id} {side}: pwe");
+    let [ak, pnu, ind, pwe] = want;
+    assert_eq!(Some(i64::from(pkw.ak.into())), ak, "{id} {side}: ak");
+    assert_eq!(Some(i64::from(pkw.pnu)), pnu, "{id} {side}: pnu");
+    assert_eq!(Some(i64::from(pkw.ind)), ind, "{id} {side}: ind");
+    assert_eq!(Some(i64::from(pkw.pwe)), pwe, "{id} {side}: pwe");
 }
 
 #[test]
@@ -66,17 +60,19 @@ fn pkw_vectors() {
     assert!(list.len() >= 30, "found {} pkw vectors", list.len());
     for v in list {
         let id = v.id.as_str();
-        let req_bytes = bytes(&v.input, "bytes").unwrap();
+        let b = v.pkw().unwrap();
+        let (i, e) = (&b.input, &b.expect);
+        let req_bytes = bytes(&i.bytes).unwrap();
         let req = PkwRequest::parse(pkw, &req_bytes).unwrap_or_else(|e| panic!("{id}: {e}"));
-        check_fields(id, "input", &req, &v.input);
+        check_fields(id, "input", &req, [Some(i.ak), Some(i.pnu), i.ind, i.pwe]);
         assert_eq!(
             req.to_bytes(pkw).unwrap(),
             req_bytes,
             "{id}: request re-encoding"
         );
-        let resp_bytes = bytes(&v.expect, "bytes").unwrap();
+        let resp_bytes = bytes(&e.bytes).unwrap();
         let resp = PkwResponse::parse(pkw, &resp_bytes).unwrap_or_else(|e| panic!("{id}: {e}"));
-        check_fields(id, "expect", &resp, &v.expect);
+        check_fields(id, "expect", &resp, [e.ak, e.pnu, e.ind, e.pwe]);
         assert_eq!(
             resp.to_bytes(pkw).unwrap(),
             resp_bytes,
@@ -130,13 +126,13 @@ fn pkw_vectors() {
                 "{id}: error {error:?} in the table"
             );
         }
-        if let Some(value) = int(&v.expect, "value") {
+        if let Some(value) = e.value {
             let Reply::Value { value: got, .. } = reply else {
                 panic!("{id}: a value reply");
             };
             assert_eq!(got, value, "{id}: signed value");
         }
-        if let Some(text) = v.expect.get("text").and_then(|t| t.as_str()) {
+        if let Some(text) = e.text.as_deref() {
             assert_eq!(
                 pkw.segment_text(resp.pnu, resp.pwe).as_deref(),
                 Some(text),
@@ -176,23 +172,25 @@ fn process_image_vectors() {
     assert!(list.len() >= 8, "found {}", list.len());
     for v in list {
         let id = v.id.as_str();
-        let direction = match v.input.get("direction").and_then(|d| d.as_str()) {
-            Some("out") => Direction::Out,
-            Some("in") => Direction::In,
+        let body = v.process_image().unwrap();
+        let direction = match body.input.direction.as_str() {
+            "out" => Direction::Out,
+            "in" => Direction::In,
             other => panic!("{id}: direction {other:?}"),
         };
-        let (image, named) = match (bytes(&v.input, "bytes"), bytes(&v.expect, "bytes")) {
-            (Some(b), None) => (b, &v.expect),
+        let (input, expect) = v.body.tables();
+        let (image, named) = match (bytes(&body.input.bytes), bytes(&body.expect.bytes)) {
+            (Some(b), None) => (b, expect),
             (None, Some(b)) => {
                 // Build from the named fields.
                 let mut builder = ImageBuilder::new(&rules, direction);
-                for (k, val) in &v.input {
+                for (k, val) in &input {
                     if k != "direction" {
                         builder.set(k, val.as_integer().unwrap()).unwrap();
                     }
                 }
                 assert_eq!(builder.bytes(), b.as_slice(), "{id}: built image");
-                (b, &v.input)
+                (b, input)
             }
             _ => panic!("{id}: bytes on one side"),
         };
@@ -221,7 +219,7 @@ fn process_image_vectors() {
                 ]
             }
         };
-        for (k, val) in named {
+        for (k, val) in &named {
             if k == "direction" {
                 continue;
             }
@@ -241,41 +239,46 @@ fn record_vectors() {
     assert!(list.len() >= 9, "found {}", list.len());
     for v in list {
         let id = v.id.as_str();
-        let index = u16::try_from(int(&v.input, "index").unwrap()).unwrap();
-        let before = v.input.get("state").and_then(|s| s.get(index.to_string()));
-        let after = v.expect.get("state").and_then(|s| s.get(index.to_string()));
-        match v.input.get("op").and_then(|o| o.as_str()) {
-            Some("write") => {
-                let data = bytes(&v.input, "data").unwrap();
+        let b = v.record().unwrap();
+        let index = u16::try_from(b.input.index).unwrap();
+        let before = b
+            .input
+            .state
+            .as_ref()
+            .and_then(|s| s.get(&index.to_string()));
+        let after = b
+            .expect
+            .state
+            .as_ref()
+            .and_then(|s| s.get(&index.to_string()));
+        match b.input.op.as_str() {
+            "write" => {
+                let data = bytes(&b.input.data).unwrap();
                 let w =
                     RecordWrite::parse(rec, index, &data).unwrap_or_else(|e| panic!("{id}: {e}"));
                 assert_eq!(w.to_bytes(rec).unwrap(), data, "{id}: re-encoding");
                 assert_eq!(data.len(), rec.write_len(w.width), "{id}: 3 or 5 bytes");
                 if w.executes(rec) {
-                    assert_eq!(
-                        after.and_then(toml::Value::as_integer),
-                        Some(w.value),
-                        "{id}"
-                    );
+                    assert_eq!(after.copied(), Some(w.value), "{id}");
                 } else {
-                    assert_eq!(after, before, "{id}: an ignored write changes nothing");
+                    assert_eq!(
+                        after.map(|a| IntOrText::Int(*a)).as_ref(),
+                        before,
+                        "{id}: an ignored write changes nothing"
+                    );
                 }
             }
-            Some("read") => {
-                if let Some(data) = bytes(&v.expect, "data") {
+            "read" => {
+                if let Some(data) = bytes(&b.expect.data) {
                     let r = RecordRead::parse(rec, index, &data).unwrap();
                     let RecordValue::Number { width, value } = r.value else {
                         panic!("{id}: a number");
                     };
-                    assert_eq!(
-                        Some(value),
-                        before.and_then(toml::Value::as_integer),
-                        "{id}"
-                    );
+                    assert_eq!(Some(&IntOrText::Int(value)), before, "{id}");
                     assert_eq!(data.len(), rec.read_len(width), "{id}: 2 or 4 bytes");
                     assert_eq!(r.to_bytes(rec).unwrap(), data, "{id}: re-encoding");
                 } else {
-                    let text = v.expect.get("text").and_then(|t| t.as_str()).unwrap();
+                    let text = b.expect.text.as_deref().unwrap();
                     let r = RecordRead {
                         index,
                         value: RecordValue::Text(text.as_bytes().to_vec()),

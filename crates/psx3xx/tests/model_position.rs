@@ -16,16 +16,23 @@ use drivespec_positioner::axis::spindle_factors;
 use drivespec_positioner::CoreEvent;
 use drivespec_psx3xx::isdu::Response;
 use drivespec_psx3xx::model::{DriveConfig, Event};
-use drivespec_spec::{Vector, VectorKind, VectorResult};
+use drivespec_spec::{IntOrText, PositionExpect, PositionInput, Vector, VectorKind, VectorResult};
 use model_util::*;
-use toml::Value as T;
 
-fn int(v: &Vector, k: &str) -> Option<i64> {
-    v.input(k).and_then(T::as_integer)
+fn pin(v: &Vector) -> &PositionInput {
+    &v.position().unwrap().input
 }
 
-fn want(v: &Vector, k: &str) -> Option<i64> {
-    v.expected(k).and_then(T::as_integer)
+fn pex(v: &Vector) -> &PositionExpect {
+    &v.position().unwrap().expect
+}
+
+/// A direction given as a code (PSx3xx ISDU 123).
+fn code(d: &IntOrText) -> Option<i64> {
+    match d {
+        IntOrText::Int(i) => Some(*i),
+        IntOrText::Text(_) => None,
+    }
 }
 
 fn eq(what: &str, got: i64, want: Option<i64>) -> Result<(), String> {
@@ -38,22 +45,21 @@ fn eq(what: &str, got: i64, want: Option<i64>) -> Result<(), String> {
 /// A drive whose shaft stands where `actual` lies for the scaling and referencing value of the
 /// vector (5.5: user value = mapped encoder value + referencing value).
 fn drive_at(v: &Vector) -> Sim {
-    let num = int(v, "numerator").unwrap_or(400);
-    let den = int(v, "denominator_before")
-        .or(int(v, "denominator"))
+    let num = pin(v).numerator.unwrap_or(400);
+    let den = pin(v)
+        .denominator_before
+        .or(pin(v).denominator)
         .unwrap_or(400)
         .clamp(1, 10_000);
-    let reference = int(v, "reference_before")
-        .or(int(v, "reference"))
-        .unwrap_or(0);
-    let actual = int(v, "actual").unwrap_or(51200);
+    let reference = pin(v).reference_before.or(pin(v).reference).unwrap_or(0);
+    let actual = pin(v).actual.unwrap_or(51200);
     // Physical steps at the vector's scaling, as base steps (400 per revolution).
     let base = i128::from(actual - reference) * i128::from(num) / i128::from(den);
     let config = DriveConfig::new("PSE312-8").with_start_position(base as i64);
     let mut s = Sim::with(config);
     s.write_ok(124, num);
     s.write_ok(125, den);
-    if let Some(d) = int(v, "direction_before") {
+    if let Some(d) = pin(v).direction_before {
         s.write_ok(123, d);
     }
     s.write_ok(127, reference);
@@ -69,79 +75,83 @@ fn ume_window(s: &Sim) -> (i64, i64) {
 }
 
 fn mapping(v: &Vector) -> Result<(), String> {
-    if let (Some(pitch), Some(res)) = (int(v, "pitch_um"), int(v, "resolution_um")) {
+    if let (Some(pitch), Some(res)) = (pin(v).pitch_um, pin(v).resolution_um) {
         let (num, den) = spindle_factors(400, pitch, res).ok_or("no factors")?;
-        eq("numerator", num, want(v, "numerator"))?;
-        eq("denominator", den, want(v, "denominator"))?;
+        eq("numerator", num, pex(v).numerator)?;
+        eq("denominator", den, pex(v).denominator)?;
         let mut s = Sim::new("PSE312-8");
         s.write_ok(124, num);
         s.write_ok(125, den);
         let spr = s.drive.core().axis().increments_per_rotation().round() as i64;
-        return eq("steps per revolution", spr, want(v, "steps_per_revolution"));
+        return eq("steps per revolution", spr, pex(v).steps_per_revolution);
     }
-    if int(v, "denominator") == Some(10_001) {
+    if pin(v).denominator == Some(10_001) {
         let mut s = Sim::new("PSE312-8");
         let r = s.write(125, 10_001);
         let accepted = r == Response::Write;
         return eq(
             "accepted",
             i64::from(accepted),
-            want(v, "accepted").or(Some(0)),
+            pex(v).accepted.map(i64::from).or(Some(0)),
         );
     }
     let mut s = drive_at(v);
-    if let Some(t) = int(v, "target") {
+    if let Some(t) = pin(v).target {
         // A valid target, transferred without release (4.5.1).
         s.f1(0x04, t as i32);
     }
-    let testing_ume = int(v, "upper_mapping_end_before").is_some()
-        || v.expected("accepted").is_some()
-        || v.expected("upper_mapping_end").is_none();
-    if let Some(before) = int(v, "upper_mapping_end_before") {
+    let testing_ume = pin(v).upper_mapping_end_before.is_some()
+        || pex(v).accepted.is_some()
+        || pex(v).upper_mapping_end.is_none();
+    if let Some(before) = pin(v).upper_mapping_end_before {
         s.write_ok(128, before);
-    } else if let (Some(ume), false) = (int(v, "upper_mapping_end"), testing_ume) {
+    } else if let (Some(ume), false) = (pin(v).upper_mapping_end, testing_ume) {
         s.write_ok(128, ume);
     }
-    for (k, idx) in [
-        ("upper_limit", 129),
-        ("lower_limit", 130),
-        ("window", 131),
-        ("loop_length", 132),
+    let (i, e) = (pin(v), pex(v));
+    for (input, expect, idx) in [
+        (i.upper_limit, e.upper_limit, 129),
+        (i.lower_limit, e.lower_limit, 130),
+        (i.window, e.window, 131),
+        (i.loop_length, e.loop_length, 132),
     ] {
-        if let Some(x) = int(v, k) {
-            if v.expected(k).is_none() || int(v, "denominator_before").is_some() {
+        if let Some(x) = input {
+            if expect.is_none() || i.denominator_before.is_some() {
                 s.write_ok(idx, x);
             }
         }
     }
     // The change under test.
-    if let (Some(d0), Some(d)) = (int(v, "denominator_before"), int(v, "denominator")) {
+    if let (Some(d0), Some(d)) = (pin(v).denominator_before, pin(v).denominator) {
         if d0 != d {
             s.write_ok(125, d);
         }
     }
-    if let (Some(_), Some(r)) = (int(v, "reference_before"), int(v, "reference")) {
+    if let (Some(_), Some(r)) = (pin(v).reference_before, pin(v).reference) {
         s.write_ok(127, r);
     }
-    if let (Some(_), Some(d)) = (int(v, "direction_before"), int(v, "direction")) {
+    if let (Some(_), Some(d)) = (
+        pin(v).direction_before,
+        pin(v).direction.as_ref().and_then(code),
+    ) {
         s.write_ok(123, d);
     }
-    if let Some(a) = int(v, "write_actual") {
+    if let Some(a) = pin(v).write_actual {
         s.write_ok(67, a);
     }
     let mut accepted = None;
     let actual = s.actual();
-    let ume_write = match v.input("range").and_then(T::as_str) {
+    let ume_write = match pin(v).range.as_deref() {
         // 5.5 method 2: the whole range above or below the displayed position.
         Some("up") => Some(actual + s.drive.core().axis().lower_offset()),
         Some("down") => Some(actual + s.drive.core().axis().upper_margin()),
-        _ => match (int(v, "down_revolutions"), int(v, "up_revolutions")) {
+        _ => match (pin(v).down_revolutions, pin(v).up_revolutions) {
             // 5.6.4: the top wanted position plus the 3-revolution margin.
             (Some(_), Some(up)) => {
                 let spr = s.drive.core().axis().increments_per_rotation().round() as i64;
                 Some(actual + up * spr + 3 * spr)
             }
-            _ if testing_ume => int(v, "upper_mapping_end"),
+            _ if testing_ume => pin(v).upper_mapping_end,
             _ => None,
         },
     };
@@ -149,48 +159,40 @@ fn mapping(v: &Vector) -> Result<(), String> {
     if let Some(u) = ume_write {
         accepted = Some(s.write(128, u) == Response::Write);
     }
-    eq("ume_min", ume_min, want(v, "ume_min"))?;
-    eq("ume_max", ume_max, want(v, "ume_max"))?;
-    if let (Some(a), Some(w)) = (accepted, v.expected("accepted").and_then(T::as_bool)) {
+    eq("ume_min", ume_min, pex(v).ume_min)?;
+    eq("ume_max", ume_max, pex(v).ume_max)?;
+    if let (Some(a), Some(w)) = (accepted, pex(v).accepted) {
         if a != w {
             return Err(format!("mapping end accepted = {a}, expected {w}"));
         }
     }
     let spr = s.drive.core().axis().increments_per_rotation().round() as i64;
-    eq("steps per revolution", spr, want(v, "steps_per_revolution"))?;
-    eq(
-        "upper mapping end",
-        s.read(128),
-        want(v, "upper_mapping_end"),
-    )?;
-    eq("upper limit", s.read(129), want(v, "upper_limit"))?;
-    eq("lower limit", s.read(130), want(v, "lower_limit"))?;
-    eq("referencing value", s.read(127), want(v, "reference"))?;
-    eq("actual", s.read(67), want(v, "actual"))?;
-    eq("window", s.read(131), want(v, "window"))?;
-    eq("loop length", s.read(132), want(v, "loop_length"))?;
-    if let Some(t) = want(v, "target") {
+    eq("steps per revolution", spr, pex(v).steps_per_revolution)?;
+    eq("upper mapping end", s.read(128), pex(v).upper_mapping_end)?;
+    eq("upper limit", s.read(129), pex(v).upper_limit)?;
+    eq("lower limit", s.read(130), pex(v).lower_limit)?;
+    eq("referencing value", s.read(127), pex(v).reference)?;
+    eq("actual", s.read(67), pex(v).actual)?;
+    eq("window", s.read(131), pex(v).window)?;
+    eq("loop length", s.read(132), pex(v).loop_length)?;
+    if let Some(t) = pex(v).target {
         eq(
             "target",
             s.drive.core().axis().target().unwrap_or(i64::MIN),
             Some(t),
         )?;
     }
-    eq(
-        "travel down",
-        s.actual() - s.read(130),
-        want(v, "travel_down"),
-    )?;
-    eq("travel up", s.read(129) - s.actual(), want(v, "travel_up"))?;
+    eq("travel down", s.actual() - s.read(130), pex(v).travel_down)?;
+    eq("travel up", s.read(129) - s.actual(), pex(v).travel_up)?;
     Ok(())
 }
 
 /// Loop planning (4.2): the legs a run to the target takes from `actual`.
 fn legs(v: &Vector) -> Result<(), String> {
-    let actual = int(v, "actual").unwrap_or(51200);
-    let dir = int(v, "loop_direction").unwrap_or(0);
+    let actual = pin(v).actual.unwrap_or(51200);
+    let dir = pin(v).loop_direction.unwrap_or(0);
     let sign = if dir == 0 { 1 } else { -1 };
-    let last_manual = v.input("last_move").and_then(T::as_str) == Some("manual");
+    let last_manual = pin(v).last_move.as_deref() == Some("manual");
     // A run that ends in loop direction, or (like a manual run) one without loop that ends
     // against it, leaving the lash in the drive (status bit 8).
     let from = if last_manual {
@@ -200,7 +202,7 @@ fn legs(v: &Vector) -> Result<(), String> {
     };
     let mut s = Sim::with(DriveConfig::new("PSE312-8").with_start_position(from));
     s.write_ok(134, dir);
-    s.write_ok(132, int(v, "loop_length").unwrap_or(250));
+    s.write_ok(132, pin(v).loop_length.unwrap_or(250));
     s.f1(if last_manual { 0x54 } else { 0x14 }, actual as i32);
     s.settle(60_000);
     s.f1(0x00, actual as i32);
@@ -210,15 +212,15 @@ fn legs(v: &Vector) -> Result<(), String> {
     if s.bit(8) != last_manual {
         return Err(format!("status bit 8 = {} after the setup", s.bit(8)));
     }
-    if let Some(hi) = int(v, "upper_limit") {
+    if let Some(hi) = pin(v).upper_limit {
         s.write_ok(129, hi);
     }
-    if let Some(lo) = int(v, "lower_limit") {
+    if let Some(lo) = pin(v).lower_limit {
         s.write_ok(130, lo);
     }
     while s.drive.poll_event().is_some() {}
-    let target = int(v, "target").ok_or("no target")?;
-    let no_loop = v.input("no_loop").and_then(T::as_bool) == Some(true);
+    let target = pin(v).target.ok_or("no target")?;
+    let no_loop = pin(v).no_loop == Some(true);
     s.f1(if no_loop { 0x54 } else { 0x14 }, target as i32);
     let mut waypoints = None;
     while let Some((_, e)) = s.drive.poll_event() {
@@ -227,7 +229,7 @@ fn legs(v: &Vector) -> Result<(), String> {
         }
     }
     let valid = !s.bit(12);
-    if let Some(w) = v.expected("valid_target").and_then(T::as_bool) {
+    if let Some(w) = pex(v).valid_target {
         if w != valid {
             return Err(format!(
                 "valid target = {valid}, status {:#06x}",
@@ -241,19 +243,12 @@ fn legs(v: &Vector) -> Result<(), String> {
         .into_iter()
         .filter(|w| *w != actual)
         .collect();
-    if let Some(want) = v.expected("legs").and_then(T::as_array) {
-        let want: Vec<i64> = want.iter().filter_map(T::as_integer).collect();
-        if want != legs {
+    if let Some(want) = &pex(v).legs {
+        if *want != legs {
             return Err(format!("legs {legs:?}, expected {want:?}"));
         }
     }
-    for b in v
-        .expected("status_set")
-        .and_then(T::as_array)
-        .into_iter()
-        .flatten()
-        .filter_map(T::as_integer)
-    {
+    for &b in pex(v).status_set.iter().flatten() {
         if !s.bit(b as u32) {
             return Err(format!("status bit {b} not set"));
         }
@@ -268,7 +263,7 @@ fn legs(v: &Vector) -> Result<(), String> {
 }
 
 fn run(v: &Vector) -> Result<(), String> {
-    if v.input("last_move").is_some() {
+    if pin(v).last_move.is_some() {
         legs(v)
     } else {
         mapping(v)
@@ -320,50 +315,51 @@ fn formula_vectors_come_out_as_the_manual_says() {
         .iter()
         .filter(|v| v.kind == VectorKind::Formula)
     {
-        let f = v.input("formula").and_then(T::as_str).unwrap();
-        match f {
+        let (fi, fe) = v.formula().map(|b| (&b.input, &b.expect)).unwrap();
+        match fi.formula.as_str() {
             "torque-at-reduced-speed" => {
                 // PSX-TRQ-003: at the set speed, ISDU 153 accepts up to the bound, not above.
                 let mut s = Sim::new(v.model.as_deref().unwrap());
-                let set = int(v, "set_speed_rpm").unwrap();
+                let set = fi.set_speed_rpm.unwrap();
                 s.write_ok(142, set);
                 s.write_ok(145, set.min(s.read(145)));
-                let bound = want(v, "max_torque_cnm").unwrap();
+                let bound = fe.max_torque_cnm.unwrap();
                 assert_eq!(s.write(153, bound), Response::Write, "{}", v.id);
                 assert_ne!(s.write(153, bound + 1), Response::Write, "{}", v.id);
             }
             "steps-per-revolution" => {
                 let mut s = Sim::new("PSE312-8");
-                s.write_ok(124, int(v, "numerator").unwrap());
-                s.write_ok(125, int(v, "denominator").unwrap());
+                s.write_ok(124, fi.numerator.unwrap());
+                s.write_ok(125, fi.denominator.unwrap());
                 let spr = s.drive.core().axis().increments_per_rotation().round() as i64;
-                assert_eq!(Some(spr), want(v, "steps_per_revolution"), "{}", v.id);
+                assert_eq!(Some(spr), fe.steps_per_revolution, "{}", v.id);
             }
             "upper-mapping-end-from-top" | "limits-from-mapping-end" => {
                 // 5.6.4: numerator 400, denominator 5000, referenced to 0 at 300000.
-                let spr = int(v, "steps_per_revolution").unwrap();
+                let spr = fi.steps_per_revolution.unwrap();
                 let mut s = Sim::with(
                     DriveConfig::new("PSE312-8").with_start_position(300_000 * 400 / spr),
                 );
                 s.write_ok(125, spr);
                 s.write_ok(67, 0);
-                let ume = int(v, "upper_mapping_end")
-                    .unwrap_or_else(|| int(v, "top_position").unwrap() + 3 * spr);
-                eq("mapping end", ume, want(v, "upper_mapping_end")).unwrap();
+                let ume = fi
+                    .upper_mapping_end
+                    .unwrap_or_else(|| fi.top_position.unwrap() + 3 * spr);
+                eq("mapping end", ume, fe.upper_mapping_end).unwrap();
                 s.write_ok(128, ume);
-                eq("lower", s.read(130), want(v, "lower_limit")).unwrap();
-                eq("upper", s.read(129), want(v, "upper_limit")).unwrap();
+                eq("lower", s.read(130), fe.lower_limit).unwrap();
+                eq("upper", s.read(129), fe.upper_limit).unwrap();
             }
             "loop-steps" => {
                 let s = Sim::new("PSE312-8");
-                assert_eq!(Some(s.read(132)), want(v, "loop_steps"), "{}", v.id);
+                assert_eq!(Some(s.read(132)), fe.loop_steps, "{}", v.id);
             }
             "device-id" => {
                 let mut s = Sim::new(v.model.as_deref().unwrap());
-                s.write_ok(116, int(v, "format").unwrap());
+                s.write_ok(116, fi.format.unwrap());
                 s.write_ok(193, 1);
                 s.write_ok(2, 128);
-                assert_eq!(s.drive.device_id().map(i64::from), want(v, "device_id"));
+                assert_eq!(s.drive.device_id().map(i64::from), fe.device_id);
             }
             _ => {}
         }

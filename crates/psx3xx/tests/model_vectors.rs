@@ -23,6 +23,16 @@ fn int(v: Option<&T>) -> Option<i64> {
     v.and_then(T::as_integer)
 }
 
+/// An input of a sequence vector.
+fn input<'v>(v: &'v Vector, key: &str) -> Option<&'v T> {
+    v.sequence()?.input.get(key)
+}
+
+/// An expected value of a sequence vector.
+fn expected<'v>(v: &'v Vector, key: &str) -> Option<&'v T> {
+    v.sequence()?.expect.get(key)
+}
+
 fn list(v: Option<&T>) -> Vec<i64> {
     v.and_then(T::as_array)
         .map(|a| a.iter().filter_map(T::as_integer).collect())
@@ -32,8 +42,7 @@ fn list(v: Option<&T>) -> Vec<i64> {
 /// Builds the drive of a vector: model, software version and model code from the state, the
 /// process-data format saved and made active by a reset, the other state entries written.
 fn setup(v: &Vector) -> Result<Sim, String> {
-    let state = v
-        .input("state")
+    let state = input(v, "state")
         .and_then(T::as_table)
         .cloned()
         .unwrap_or_default();
@@ -49,7 +58,7 @@ fn setup(v: &Vector) -> Result<Sim, String> {
         config.start_position = Some(pos);
     }
     let mut s = Sim::with(config);
-    let format = int(state.get("116")).or(int(v.input("format")));
+    let format = int(state.get("116")).or(int(input(v, "format")));
     if let Some(f) = format.filter(|f| *f != i64::from(s.drive.active_format())) {
         s.write_ok(116, f);
         s.write_ok(193, 1);
@@ -318,8 +327,7 @@ fn step(s: &mut Sim, st: &toml::Table, started: &mut Option<Vec<i64>>) -> Result
 
 fn run_vector(v: &Vector) -> Result<(), String> {
     let mut s = setup(v)?;
-    let steps = v
-        .input("steps")
+    let steps = input(v, "steps")
         .and_then(T::as_array)
         .ok_or("no steps")?
         .clone();
@@ -329,17 +337,17 @@ fn run_vector(v: &Vector) -> Result<(), String> {
         step(&mut s, st, &mut started).map_err(|e| format!("step {}: {e}", i + 1))?;
         s.run_ms(8);
     }
-    if let Some(run) = v.expected("final_run").and_then(T::as_str) {
+    if let Some(run) = expected(v, "final_run").and_then(T::as_str) {
         if s.run() != run {
             return Err(format!("final run {} instead of {run}", s.run()));
         }
     }
-    if let Some(id) = int(v.expected("device_id")) {
+    if let Some(id) = int(expected(v, "device_id")) {
         if s.drive.device_id().map(i64::from) != Some(id) {
             return Err(format!("device ID {:?}", s.drive.device_id()));
         }
     }
-    if let Some(state) = v.expected("final_state").and_then(T::as_table) {
+    if let Some(state) = expected(v, "final_state").and_then(T::as_table) {
         for (k, val) in state {
             let got = s.read(k.parse().unwrap());
             if Some(got) != val.as_integer() {

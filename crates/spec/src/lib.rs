@@ -13,6 +13,7 @@ mod family;
 mod files;
 pub mod hex;
 mod load;
+mod model_values;
 mod parameter;
 mod range;
 mod requirement;
@@ -24,7 +25,7 @@ pub mod psd4xx;
 pub mod psx3xx;
 
 pub use bitfield::{BitRule, Bitfield, BitfieldBit, BitfieldValue, RuleAction};
-pub use device_model::{DeviceModel, ModelParam};
+pub use device_model::{DeviceModel, ModelParam, ParamSet};
 pub use erratum::{Erratum, Reading, ReadingError, Readings};
 pub use error::{Problem, ProblemKind, SpecErrors};
 pub use family::{Family, FamilyId, FamilyInfo, Protocol};
@@ -32,7 +33,13 @@ pub use files::SpecFiles;
 pub use parameter::{Access, DataType, EnumValue, ModeMeaning, Parameter, Resolved};
 pub use range::Ranges;
 pub use requirement::{Level, Requirement};
-pub use vector::{Vector, VectorKind, VectorResult};
+pub use vector::{
+    Body, BodyError, DirectParameterExpect, DirectParameterInput, FormulaExpect, FormulaInput,
+    HpdFrameExpect, HpdFrameInput, HpdPlcBytesExpect, HpdPlcBytesInput, HpdPlcExpect, HpdPlcInput,
+    IntOrText, IsduExpect, IsduInput, Number, OneOrMany, PkwExpect, PkwInput, PositionExpect,
+    PositionInput, ProcessImageExpect, ProcessImageInput, RecordExpect, RecordInput,
+    TimestampExpect, TimestampInput, Vector, VectorBody, VectorKind, VectorResult,
+};
 
 use std::path::Path;
 

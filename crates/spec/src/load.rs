@@ -2,13 +2,20 @@
 
 use crate::error::{Problem, ProblemKind};
 use crate::{
-    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Family, FamilyId, FamilyInfo, Parameter,
-    Protocol, Requirement, SpecFiles, Vector,
+    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Family, FamilyId, FamilyInfo, ParamSet,
+    Parameter, Protocol, Requirement, SpecFiles, Vector,
 };
 use serde::de::DeserializeOwned;
 
 /// Top-level arrays a common file may hold.
-const COMMON_KEYS: [&str; 5] = ["parameter", "model", "bitfield", "requirement", "erratum"];
+const COMMON_KEYS: [&str; 6] = [
+    "parameter",
+    "model",
+    "param_set",
+    "bitfield",
+    "requirement",
+    "erratum",
+];
 
 /// Parses all three families. Records that do not parse are left out and reported; the
 /// families are returned whenever their `family.toml` and `protocol.toml` parse, so that
@@ -30,6 +37,7 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
     let mut protocol = None;
     let mut parameters = Vec::new();
     let mut models = Vec::new();
+    let mut param_sets = Vec::new();
     let mut bitfields = Vec::new();
     let mut requirements = Vec::new();
     let mut errata = Vec::new();
@@ -73,6 +81,7 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
         } else {
             records(path, &mut table, "parameter", &mut parameters, problems);
             records(path, &mut table, "model", &mut models, problems);
+            records(path, &mut table, "param_set", &mut param_sets, problems);
             records(path, &mut table, "bitfield", &mut bitfields, problems);
             records(path, &mut table, "requirement", &mut requirements, problems);
             records(path, &mut table, "erratum", &mut errata, problems);
@@ -111,6 +120,7 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
             },
         ));
     }
+    crate::model_values::complete(&mut models, &param_sets, &parameters, problems);
     Some(Family {
         info: info?,
         parameters,
@@ -198,6 +208,7 @@ macro_rules! record {
 record!(
     Parameter,
     DeviceModel,
+    ParamSet,
     Bitfield,
     Requirement,
     Erratum,

@@ -185,6 +185,10 @@ pub struct Parameter {
     /// The range comes from the device model.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub range_model: bool,
+    /// The model attribute that is each model's range maximum (with `range_model`; the
+    /// models give the minimum as `min`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_max: Option<String>,
     /// A range that depends on other parameters, in words.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub range_note: Option<String>,
@@ -194,6 +198,10 @@ pub struct Parameter {
     /// The default comes from the device model.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub default_model: bool,
+    /// Where each model's default comes from (with `default_model`): a model attribute, or
+    /// `max` for the top of the model's range.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_default: Option<String>,
     /// Delivery value of a string parameter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub default_text: Option<String>,

@@ -137,6 +137,24 @@ impl Validator<'_> {
         let f = self.family;
         for p in &f.parameters {
             let rec = rec_p(p);
+            let conflicts = [
+                (
+                    p.range_model && p.range.is_some(),
+                    "a range here and range_model: the models give the range",
+                ),
+                (
+                    p.model_max.is_some() && !p.range_model,
+                    "model_max without range_model",
+                ),
+                (
+                    p.model_default.is_some() && !p.default_model,
+                    "model_default without default_model",
+                ),
+            ];
+            for (_, message) in conflicts.iter().filter(|c| c.0) {
+                let message = (*message).to_owned();
+                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message });
+            }
             if let (Some(range), Some((lo, hi))) = (&p.range, p.data_type.bounds()) {
                 for [min, max] in range.intervals() {
                     if min > max {
@@ -441,61 +459,77 @@ impl Validator<'_> {
                     self.dangling(&v.file, rec.clone(), "model", m);
                 }
             }
-            for name in vector_params(&v.input).chain(vector_params(&v.expect)) {
+            for name in vector_params(&v.body) {
                 if f.parameter(&name).is_none() {
                     self.dangling(&v.file, rec.clone(), "parameter", &name);
                 }
             }
-            for key in v.kind.required_input() {
-                if !v.input.contains_key(*key) {
-                    let message = format!("a {} vector needs input key `{key}`", v.kind.as_str());
+            if let crate::VectorBody::Sequence(b) = &v.body {
+                if !b.input.contains_key("steps") && !b.expect.contains_key("rows") {
+                    let message =
+                        "a sequence vector needs input `steps` or expect `rows`".to_owned();
                     self.push(&v.file, rec.clone(), ProblemKind::Invalid { message });
                 }
-            }
-            if v.kind == crate::VectorKind::Sequence
-                && !v.input.contains_key("steps")
-                && !v.expect.contains_key("rows")
-            {
-                let message = "a sequence vector needs input `steps` or expect `rows`".to_owned();
-                self.push(&v.file, rec.clone(), ProblemKind::Invalid { message });
             }
         }
     }
 }
 
-/// Parameters a vector names: the value of `param`, the keys of `params` (`Pr64`), of `bits`
-/// (`b99.14` names Pb99/Pr99) and of `dwords` (`Pr64:65` names Pr64 and Pr65).
-fn vector_params(table: &toml::Table) -> impl Iterator<Item = String> + '_ {
-    let param = table
-        .get("param")
-        .and_then(toml::Value::as_str)
-        .map(str::to_owned);
-    let keys = |key: &'static str| {
-        table
-            .get(key)
-            .and_then(toml::Value::as_table)
-            .into_iter()
-            .flat_map(|t| t.keys())
+/// Parameters a vector names: the HPD `param` of a request, the keys of `params` (`Pr64`),
+/// of `bits` (`b99.14` names Pb99/Pr99) and of `dwords` (`Pr64:65` names Pr64 and Pr65), and
+/// the parameter ids keying `state` and `saved`.
+fn vector_params(body: &crate::VectorBody) -> Vec<String> {
+    use crate::VectorBody as B;
+    let keys = |m: &Option<BTreeMap<String, i64>>| -> Vec<String> {
+        m.iter().flat_map(|m| m.keys().cloned()).collect()
     };
-    let params = keys("params").map(|k| k.to_owned());
-    let bits = keys("bits").filter_map(|k| {
-        k.strip_prefix('b')?
-            .split_once('.')
-            .map(|(n, _)| n.to_owned())
-    });
-    let dwords = keys("dwords").flat_map(|k| {
-        let (lo, hi) = k.split_once(':').unwrap_or((k, ""));
-        let prefix: String = lo.chars().take_while(|c| c.is_ascii_alphabetic()).collect();
-        [
-            Some(lo.to_owned()),
-            (!hi.is_empty()).then(|| format!("{prefix}{hi}")),
+    let bits = |m: &Option<BTreeMap<String, i64>>| -> Vec<String> {
+        keys(m)
+            .iter()
+            .filter_map(|k| {
+                k.strip_prefix('b')?
+                    .split_once('.')
+                    .map(|(n, _)| n.to_owned())
+            })
+            .collect()
+    };
+    match body {
+        B::HpdFrame(b) => b.input.param.iter().cloned().collect(),
+        B::HpdPlc(b) => {
+            let dwords = b.expect.dwords.iter().flat_map(|m| m.keys()).flat_map(|k| {
+                let (lo, hi) = k.split_once(':').unwrap_or((k, ""));
+                let prefix: String = lo.chars().take_while(|c| c.is_ascii_alphabetic()).collect();
+                [
+                    Some(lo.to_owned()),
+                    (!hi.is_empty()).then(|| format!("{prefix}{hi}")),
+                ]
+            });
+            [
+                keys(&b.input.params),
+                keys(&b.expect.params),
+                bits(&b.input.bits),
+                bits(&b.expect.bits),
+            ]
+            .concat()
+            .into_iter()
+            .chain(dwords.flatten())
+            .collect()
+        }
+        B::Pkw(b) => [state_keys(&b.input.state), keys(&b.expect.state)].concat(),
+        B::Record(b) => [state_keys(&b.input.state), keys(&b.expect.state)].concat(),
+        B::Isdu(b) => [
+            keys(&b.input.state),
+            keys(&b.expect.state),
+            keys(&b.expect.saved),
         ]
-    });
-    param
-        .into_iter()
-        .chain(params)
-        .chain(bits)
-        .chain(dwords.flatten())
+        .concat(),
+        _ => Vec::new(),
+    }
+}
+
+/// The parameter ids keying a `state` table.
+fn state_keys(state: &Option<BTreeMap<String, crate::IntOrText>>) -> Vec<String> {
+    state.iter().flat_map(|m| m.keys().cloned()).collect()
 }
 
 fn rec_p(p: &Parameter) -> String {

@@ -79,7 +79,7 @@ fn unknown_key_is_rejected() {
 #[test]
 fn unknown_top_level_key_is_rejected() {
     let p = one_problem("[[parametr]]\nid = \"1\"\n");
-    assert_eq!(p, "psd4xx/test.toml: unknown top-level key `parametr`, expected one of: parameter, model, bitfield, requirement, erratum");
+    assert_eq!(p, "psd4xx/test.toml: unknown top-level key `parametr`, expected one of: parameter, model, param_set, bitfield, requirement, erratum");
 }
 
 #[test]
@@ -487,27 +487,52 @@ fn every_problem_is_reported_not_just_the_first() {
     assert_eq!(problems_with("psd4xx/test.toml", &bad).len(), 2);
 }
 
-#[test]
-fn vector_needs_its_kinds_input_keys() {
+/// Loads the skeleton with `REQ` and `vector` as `psd4xx/vectors/test.toml`.
+fn vector_problems(vector: &str) -> Vec<String> {
     let mut files = skeleton();
     files.set("psd4xx/test.toml", REQ);
-    files.set(
-        "psd4xx/vectors/test.toml",
-        &VECTOR.replace(
-            "ak = 1\npnu = 44\n[vector.expect]",
-            "pnu = 44\n[vector.expect]",
-        ),
-    );
-    let problems: Vec<String> = match Spec::from_files(&files) {
+    files.set("psd4xx/vectors/test.toml", vector);
+    match Spec::from_files(&files) {
         Ok(_) => Vec::new(),
         Err(e) => e.0.iter().map(ToString::to_string).collect(),
-    };
+    }
+}
+
+#[test]
+fn vector_needs_its_kinds_input_keys() {
+    let problems = vector_problems(&VECTOR.replace(
+        "ak = 1\npnu = 44\n[vector.expect]",
+        "pnu = 44\n[vector.expect]",
+    ));
     assert_eq!(
         problems,
         vec![
-            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": a pkw vector needs input key `ak`"#
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": input: missing field `ak`"#
                 .to_owned()
         ]
+    );
+}
+
+#[test]
+fn vector_key_must_be_known_to_its_kind() {
+    let problems = vector_problems(&VECTOR.replace("pwe = 2", "pwe_value = 2"));
+    assert_eq!(problems.len(), 1, "{problems:#?}");
+    assert!(
+        problems[0].starts_with(
+            r#"psd4xx/vectors/test.toml: vector "pkw-read-44": expect: unknown field `pwe_value`, expected one of"#
+        ),
+        "{problems:#?}"
+    );
+}
+
+#[test]
+fn vector_value_must_have_its_keys_type() {
+    let problems = vector_problems(&VECTOR.replace("pnu = 44", "pnu = \"44\""));
+    assert_eq!(problems.len(), 1, "{problems:#?}");
+    assert!(
+        problems[0]
+            .starts_with(r#"psd4xx/vectors/test.toml: vector "pkw-read-44": input: invalid type"#),
+        "{problems:#?}"
     );
 }
 
@@ -516,11 +541,8 @@ fn vector_parameters_must_exist() {
     let mut files = skeleton();
     files.set("psd4xx/test.toml", &format!("{PARAM}{REQ}"));
     let v = VECTOR
-        .replace("pnu = 44\n", "pnu = 44\nparam = \"45\"\n")
-        .replace(
-            "pwe = 2\n",
-            "pwe = 2\nparams = { \"44\" = 2, \"46\" = 1 }\n",
-        );
+        .replace("pnu = 44\n", "pnu = 44\nstate = { \"45\" = 1 }\n")
+        .replace("pwe = 2\n", "pwe = 2\nstate = { \"44\" = 2, \"46\" = 1 }\n");
     files.set("psd4xx/vectors/test.toml", &v);
     let problems: Vec<String> = match Spec::from_files(&files) {
         Ok(_) => Vec::new(),
@@ -534,5 +556,102 @@ fn vector_parameters_must_exist() {
             r#"psd4xx/vectors/test.toml: vector "pkw-read-44": parameter "46" does not exist"#
                 .to_owned(),
         ]
+    );
+}
+
+/// The problems of the built-in spec with one file edited (`from` must occur in it).
+fn builtin_problems_with(file: &str, from: &str, to: &str) -> Vec<String> {
+    let mut files = SpecFiles::builtin();
+    let text = files.get(file).unwrap_or_default();
+    assert!(text.contains(from), "{file} has no {from:?}");
+    files.set(file, &text.replacen(from, to, 1));
+    match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    }
+}
+
+#[test]
+fn model_maximum_contradicting_its_attribute_is_reported() {
+    let problems = builtin_problems_with(
+        "psx3xx/models.toml",
+        r#"{ id = "142", min = 15 },"#,
+        r#"{ id = "142", range = [[15, 999]] },"#,
+    );
+    // Every model of the set is named, each with its own attribute.
+    assert_eq!(problems.len(), 12, "{problems:#?}");
+    assert_eq!(
+        problems[0],
+        r#"psx3xx/models.toml: model "PSE301-8": range of parameter "142" written out (maximum 999); its maximum is the attribute max_speed_rpm = 230: give `min` only"#
+    );
+}
+
+#[test]
+fn model_default_repeating_its_attribute_is_reported() {
+    let problems = builtin_problems_with(
+        "psx3xx/models.toml",
+        r#"{ id = "143", min = 15 },"#,
+        r#"{ id = "143", min = 15, default = 230 },"#,
+    );
+    let written: Vec<&String> = problems
+        .iter()
+        .filter(|p| p.contains("written out"))
+        .collect();
+    assert_eq!(written.len(), 12, "{problems:#?}");
+    assert_eq!(
+        problems[0],
+        r#"psx3xx/models.toml: model "PSE301-8": default 230 of parameter "143" written out; it is the same as max (230): leave it out"#
+    );
+    assert!(
+        problems[8].contains("contradicted by max (180)"),
+        "{problems:#?}"
+    );
+}
+
+#[test]
+fn parameter_range_where_the_models_give_it_is_reported() {
+    let problems = builtin_problems_with(
+        "psx3xx/parameters.toml",
+        "range_model = true\nmodel_max = \"max_speed_rpm\"\n",
+        "range = [[15, 999]]\nrange_model = true\nmodel_max = \"max_speed_rpm\"\n",
+    );
+    assert_eq!(
+        problems,
+        vec![
+            r#"psx3xx/parameters.toml: parameter "142": a range here and range_model: the models give the range"#
+                .to_owned()
+        ]
+    );
+}
+
+#[test]
+fn model_needs_the_attribute_its_values_follow_from() {
+    let problems = builtin_problems_with("psx3xx/models.toml", "rated_torque_cnm = 100.0, ", "");
+    assert_eq!(
+        problems,
+        vec![
+            r#"psx3xx/models.toml: model "PSE301-8": the model has no attribute rated_torque_cnm, which parameter "153" takes its maximum from"#
+                .to_owned(),
+            r#"psx3xx/models.toml: model "PSE301-8": model "PSE301-8" gives no range for parameter "153""#
+                .to_owned(),
+            r#"psx3xx/models.toml: model "PSE301-8": model "PSE301-8" gives no default for parameter "153""#
+                .to_owned(),
+        ]
+    );
+}
+
+#[test]
+fn model_param_set_must_exist() {
+    let problems = builtin_problems_with(
+        "psx3xx/models.toml",
+        "param_set = \"3418\"",
+        "param_set = \"3419\"",
+    );
+    assert!(
+        problems.contains(
+            &r#"psx3xx/models.toml: model "PSE3418-14": param_set "3419" does not exist"#
+                .to_owned()
+        ),
+        "{problems:#?}"
     );
 }

@@ -11,6 +11,7 @@ use drivespec_hpd::params::Target;
 use drivespec_hpd::{parse, Data, Message};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Level, Vector, VectorKind, VectorResult};
+use std::collections::BTreeMap;
 
 pub(crate) fn generate(g: &mut Gen) {
     broadcast(g);
@@ -972,14 +973,6 @@ fn baud(g: &mut Gen) {
     }
 }
 
-fn text_of<'v>(v: &'v Vector, key: &str) -> Option<&'v str> {
-    v.input(key).and_then(|x| x.as_str())
-}
-
-fn int_of(v: &Vector, key: &str) -> Option<i64> {
-    v.input(key).and_then(toml::Value::as_integer)
-}
-
 /// The spec's `hpd-frame` vectors, run against the device at the vector's address.
 fn vectors(g: &mut Gen) {
     let own = g.addr;
@@ -990,12 +983,15 @@ fn vectors(g: &mut Gen) {
         .filter(|v| v.kind == VectorKind::HpdFrame)
         .collect();
     for v in vectors {
-        let Some(request) = text_of(v, "request").and_then(|h| parse_hex(h).ok()) else {
+        let Some(body) = v.hpd_frame() else {
+            continue;
+        };
+        let Ok(request) = parse_hex(&body.input.request) else {
             g.errors
                 .push(format!("vector {}: request is not hex", v.id));
             continue;
         };
-        let golden = match v.expected("response").and_then(|x| x.as_str()) {
+        let golden = match &body.expect.response {
             Some(h) => match parse_hex(h) {
                 Ok(b) => b,
                 Err(_) => {
@@ -1007,8 +1003,10 @@ fn vectors(g: &mut Gen) {
             None => Vec::new(),
         };
         let msg = parse(&g.rules, &request).ok();
-        let at = int_of(v, "drive_addr")
-            .or_else(|| int_of(v, "addr"))
+        let at = body
+            .input
+            .drive_addr
+            .or(body.input.addr)
             .and_then(|a| u8::try_from(a).ok())
             .filter(|a| *a <= g.rules.addr_max)
             .unwrap_or(own);
@@ -1029,12 +1027,9 @@ fn vectors(g: &mut Gen) {
         if at != own {
             g.readdress(&mut cb, Role::Setup, own, at);
         }
-        let name = text_of(v, "param").or_else(|| text_of(v, "target"));
+        let name = body.input.param.as_deref().or(body.input.target.as_deref());
         let target = name.and_then(|n| Target::parse(g.family, n).ok());
-        let want = v
-            .expected("value")
-            .or_else(|| v.input("value"))
-            .and_then(toml::Value::as_integer);
+        let want = body.expect.value.or(body.input.value);
         let mut compare = Compare::Exact;
         let mut touched: Vec<Slot> = Vec::new();
         let stop = matches!(msg, Some(Message::WritePlc { .. })) && at == own;
@@ -1126,35 +1121,27 @@ fn plc_vectors(g: &mut Gen) {
     let scan = u64::from(g.protocol.plc.scan_us);
     let run_name = g.protocol.plc.run_bit.clone();
     for v in vectors {
-        let Some(lines) = v.input("program").and_then(|p| p.as_array()) else {
+        let Some(body) = v.hpd_plc() else {
             continue;
         };
-        let lines: Vec<&str> = lines.iter().filter_map(|l| l.as_str()).collect();
+        let lines: Vec<&str> = body.input.program.iter().map(String::as_str).collect();
         let Some(program) = assemble(g, &lines) else {
             continue;
         };
-        let scans = int_of(v, "scans").unwrap_or(1);
+        let scans = body.input.scans.unwrap_or(1);
         if !(1..=4).contains(&scans) {
             continue;
         }
-        let table = |key: &str| -> Vec<(String, i64)> {
-            v.input(key)
-                .and_then(|t| t.as_table())
-                .map(|t| {
-                    t.iter()
-                        .filter_map(|(k, x)| Some((k.clone(), x.as_integer()?)))
-                        .collect()
-                })
-                .unwrap_or_default()
+        let table = |t: &Option<BTreeMap<String, i64>>| -> Vec<(String, i64)> {
+            t.iter()
+                .flat_map(|t| t.iter().map(|(k, x)| (k.clone(), *x)))
+                .collect()
         };
-        let expect = |key: &str| -> Vec<String> {
-            v.expected(key)
-                .and_then(|t| t.as_table())
-                .map(|t| t.keys().cloned().collect())
-                .unwrap_or_default()
+        let expect = |t: &Option<BTreeMap<String, i64>>| -> Vec<String> {
+            t.iter().flat_map(|t| t.keys().cloned()).collect()
         };
-        let params = table("params");
-        let bits = table("bits");
+        let params = table(&body.input.params);
+        let bits = table(&body.input.bits);
         // Everything set must be writable over the line.
         let settable = params.iter().all(|(k, _)| {
             g.param(k)
@@ -1212,8 +1199,8 @@ fn plc_vectors(g: &mut Gen) {
             &["HPD-PLC-004"],
         );
         g.bit(&mut cb, Role::Check, &run, false);
-        let mut reads: Vec<String> = expect("params");
-        for b in expect("bits") {
+        let mut reads: Vec<String> = expect(&body.expect.params);
+        for b in expect(&body.expect.bits) {
             if let Some(r) = g.bit_ref(&b) {
                 if !reads.contains(&r.param.id) {
                     reads.push(r.param.id.clone());
@@ -1233,7 +1220,7 @@ fn plc_vectors(g: &mut Gen) {
                 }
             }
         }
-        for d in expect("dwords") {
+        for d in expect(&body.expect.dwords) {
             let lo = d.split(':').next().unwrap_or("");
             if let Some(s) = g.slot_of(lo) {
                 let dw = Slot {

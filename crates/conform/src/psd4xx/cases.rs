@@ -825,7 +825,10 @@ impl Gen<'_> {
             }
             let mut steps = Vec::new();
             let mut window = window_default;
-            if let Some(state) = v.input("state").and_then(toml::Value::as_table) {
+            let Some(body) = v.sequence() else {
+                continue;
+            };
+            if let Some(state) = body.input.get("state").and_then(toml::Value::as_table) {
                 let mut keys: Vec<(&String, &toml::Value)> = state.iter().collect();
                 keys.sort_by_key(|(k, _)| (k.as_str() != "41", k.parse::<u32>().unwrap_or(0)));
                 for (k, value) in keys {
@@ -844,7 +847,7 @@ impl Gen<'_> {
                     self.write_pkw(&mut steps, pnu, value);
                 }
             }
-            let Some(list) = v.input("steps").and_then(toml::Value::as_array) else {
+            let Some(list) = body.input.get("steps").and_then(toml::Value::as_array) else {
                 continue;
             };
             for (n, s) in list.iter().enumerate() {
