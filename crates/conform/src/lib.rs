@@ -19,7 +19,6 @@ pub mod dut;
 pub mod fuzz;
 pub mod hpd;
 pub mod link;
-pub mod plot;
 pub mod psd4xx;
 pub mod psx3xx;
 pub mod report;

@@ -497,7 +497,7 @@ fn campaign(
             ),
         ];
         for (path, text) in files {
-            report::write_atomic(&path, &text).map_err(|e| FuzzError::Write {
+            drivespec_report::write_atomic(&path, &text).map_err(|e| FuzzError::Write {
                 file: path.display().to_string(),
                 why: e.to_string(),
             })?;

@@ -7,10 +7,10 @@ use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, Requireme
 use crate::cyclic::device::Device;
 use crate::cyclic::wire::hex;
 use crate::cyclic::{Env, Peer, PeerError, Reply, Request, Server};
-use crate::plot::{self, Sample};
 use crate::suite::Session;
 use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, Output, PkwRequest};
+use drivespec_report::plot::{self, Sample};
 use drivespec_spec::FamilyId;
 
 /// A session on one device under test.
