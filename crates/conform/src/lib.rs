@@ -15,6 +15,7 @@
 
 pub mod case;
 pub mod cyclic;
+mod cyclic_session;
 pub mod dut;
 pub mod fuzz;
 pub mod hpd;
