@@ -5,6 +5,9 @@
 
 use crate::report::{format_time, Report, SCHEMA};
 use crate::timeline::Timeline;
+use drivespec_report::escape as xml;
+use drivespec_report::junit::{self as xml_junit, Case, Form, Outcome, Suite};
+use drivespec_report::svg::polyline;
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -29,8 +32,7 @@ pub fn json(reports: &[Report]) -> String {
         unreadable: reports.iter().filter(|r| r.error.is_some()).count() as u64,
         reports,
     };
-    serde_json::to_string_pretty(&doc)
-        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+    drivespec_report::json(&doc)
 }
 
 fn stats_line(s: &crate::report::Stats) -> String {
@@ -153,79 +155,62 @@ pub fn text(reports: &[Report]) -> String {
     o
 }
 
-fn xml(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c if (c as u32) < 0x20 && !matches!(c, '\n' | '\t' | '\r') => out.push(' '),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
 /// JUnit XML: one test suite per file, one test case per requirement checked (failed when
 /// violated, with the listed violations), plus a test case for a read error.
 pub fn junit(reports: &[Report]) -> String {
-    let mut o = String::from(
-        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"drivespec check\">\n",
-    );
-    for r in reports {
-        let name = r.file.as_deref().unwrap_or("stream");
-        let failures = r.requirements.values().filter(|t| t.violations > 0).count()
-            + usize::from(r.error.is_some());
-        let tests = r.requirements.len() + usize::from(r.error.is_some());
-        let _ = writeln!(
-            o,
-            "  <testsuite name=\"{}\" tests=\"{tests}\" failures=\"{failures}\" errors=\"0\">",
-            xml(name)
-        );
-        for (id, t) in &r.requirements {
-            let _ = write!(
-                o,
-                "    <testcase classname=\"drivespec.check.{}\" name=\"{}\"",
-                xml(&r.family),
-                xml(id)
-            );
-            if t.violations == 0 {
-                o.push_str("/>\n");
-                continue;
+    let suites = reports
+        .iter()
+        .map(|r| {
+            let mut cases: Vec<Case> = r
+                .requirements
+                .iter()
+                .map(|(id, t)| {
+                    let outcome = if t.violations == 0 {
+                        Outcome::Passed
+                    } else {
+                        let mut text = String::new();
+                        for v in r.violations.iter().filter(|v| &v.requirement == id) {
+                            let _ = writeln!(text, "{}: {}: {}", v.at, v.subject, v.message);
+                        }
+                        Outcome::Failed {
+                            message: format!("{} violation(s): {}", t.violations, t.text),
+                            kind: t.level.clone(),
+                            text: Some(text),
+                        }
+                    };
+                    Case {
+                        name: id.clone(),
+                        classname: format!("drivespec.check.{}", r.family),
+                        time_ms: 0.0,
+                        outcome,
+                    }
+                })
+                .collect();
+            if let Some(e) = &r.error {
+                cases.push(Case {
+                    name: "readable".to_owned(),
+                    classname: "drivespec.check.input".to_owned(),
+                    time_ms: 0.0,
+                    outcome: Outcome::Failed {
+                        message: e.message.clone(),
+                        kind: "input".to_owned(),
+                        text: None,
+                    },
+                });
             }
-            o.push_str(">\n");
-            let _ = writeln!(
-                o,
-                "      <failure message=\"{} violation(s): {}\" type=\"{}\">",
-                t.violations,
-                xml(&t.text),
-                xml(&t.level)
-            );
-            for v in r.violations.iter().filter(|v| &v.requirement == id) {
-                let _ = writeln!(
-                    o,
-                    "{}: {}: {}",
-                    xml(&v.at.to_string()),
-                    xml(&v.subject),
-                    xml(&v.message)
-                );
+            Suite {
+                name: r.file.as_deref().unwrap_or("stream").to_owned(),
+                properties: Vec::new(),
+                cases,
             }
-            o.push_str("      </failure>\n    </testcase>\n");
-        }
-        if let Some(e) = &r.error {
-            let _ = writeln!(
-                o,
-                "    <testcase classname=\"drivespec.check.input\" name=\"readable\">\n      <failure message=\"{}\" type=\"input\"/>\n    </testcase>",
-                xml(&e.message)
-            );
-        }
-        o.push_str("  </testsuite>\n");
+        })
+        .collect();
+    xml_junit::Document {
+        name: "drivespec check".to_owned(),
+        form: Form::Counted,
+        suites,
     }
-    o.push_str("</testsuites>\n");
-    o
+    .to_xml()
 }
 
 /// An SVG timeline: position and target, speed, the 16 status bits, violation marks.
@@ -275,11 +260,10 @@ fn svg(t: &Timeline) -> String {
         if pts.is_empty() {
             return;
         }
-        let d: Vec<String> = pts.iter().map(|(a, b)| format!("{a:.1},{b:.1}")).collect();
         let _ = writeln!(
             o,
-            "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"1\" points=\"{}\"/>",
-            d.join(" ")
+            "{}",
+            polyline(&pts, &format!("stroke=\"{color}\" stroke-width=\"1\""))
         );
     };
     let _ = writeln!(o, "<text x=\"2\" y=\"20\">position</text><text x=\"2\" y=\"32\">{phi:.0}</text><text x=\"2\" y=\"{:.0}\">{plo:.0}</text>", 10.0 + h_pos);

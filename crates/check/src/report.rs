@@ -353,8 +353,7 @@ impl Report {
 
     /// The JSON form (schema `drivespec-check/1`).
     pub fn json(&self) -> String {
-        serde_json::to_string_pretty(self)
-            .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+        drivespec_report::json(self)
     }
 }
 

@@ -132,11 +132,7 @@ impl Context {
     }
 }
 
-/// Pretty JSON of a value.
-pub fn json<T: serde::Serialize>(v: &T) -> String {
-    serde_json::to_string_pretty(v)
-        .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
-}
+pub use drivespec_report::json;
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {

@@ -17,10 +17,10 @@
 
 pub mod case;
 pub mod cyclic;
+mod cyclic_session;
 pub mod dut;
 pub mod fuzz;
 pub mod hpd;
-pub mod plot;
 pub mod psd4xx;
 pub mod psx3xx;
 pub mod report;

@@ -516,7 +516,7 @@ fn write_reports(opts: &Options, report: &Report) -> Result<Vec<PathBuf>, Confor
     ];
     let mut written = Vec::new();
     for (path, text) in files {
-        report::write_atomic(&path, &text).map_err(|e| ConformError::Write {
+        drivespec_report::write_atomic(&path, &text).map_err(|e| ConformError::Write {
             file: path.display().to_string(),
             why: e.to_string(),
         })?;

@@ -2,12 +2,15 @@
 //! capabilities, the bounds a replay file cannot exceed, the signature of a step and how a
 //! failed case run becomes a finding (README "Cyclic-exchange protocol", "Fuzzing").
 
-use super::engine::{Fault, Trial};
-use super::replay::{Action, CyclicStep, FindingClass, Step};
-use crate::case::{CaseRun, Outcome, RequirementRef};
+use super::engine::{self, Fault, Target, Trial};
+use super::replay::{Action, CyclicStep, FindingClass, Start, Step};
+use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef};
 use crate::cyclic::{Env, PeerError};
-use crate::link::Caps;
-use drivespec_spec::Family;
+use crate::cyclic_session::{CyclicFamily, CyclicSession};
+use crate::link::{Caps, LinkError};
+use crate::rng::Rng;
+use crate::suite::{Session, SetupError};
+use drivespec_spec::{Family, FamilyId, Level};
 
 /// Every run starts with `RESET` on the device and a fresh reference, on any transport; times
 /// are virtual (carried in the requests).
@@ -100,5 +103,96 @@ pub(crate) fn trial(
             signature,
             failure,
         }),
+    }
+}
+
+/// What a cyclic family's fuzz target adds to its conformance session: the sequences, the
+/// case a sequence runs as, and the names of its steps and of what differs.
+pub(crate) trait CyclicFuzz<'s> {
+    /// The family the session runs.
+    type Family: CyclicFamily<'s>;
+    /// A new sequence.
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step>;
+    /// The case a sequence runs as.
+    fn case(&self, steps: &[Step]) -> (CaseInfo, <Self::Family as CyclicFamily<'s>>::Case);
+    /// Which parts of the failing step's answer differ.
+    fn differs(&self, run: &CaseRun, step: usize) -> String;
+    /// The signature names of the family's own steps ([`kind`] names the shared ones).
+    fn own_kind(c: &CyclicStep) -> Option<String>;
+    /// The family's spec.
+    fn spec(&self) -> &Family;
+}
+
+/// A cyclic family's fuzz target on one device under test: its session and its fuzz part.
+pub(crate) struct CyclicTarget<'a, F, P> {
+    session: CyclicSession<'a, F>,
+    part: P,
+}
+
+impl<'a, 's, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> CyclicTarget<'a, F, P> {
+    /// A target on `session`, greeted with `HELLO`; `part` gets the kinds of the injections in
+    /// `envs` the device takes (they are optional, only those are sent).
+    pub(crate) fn new(
+        mut session: CyclicSession<'a, F>,
+        envs: &[Env],
+        part: impl FnOnce(Vec<String>) -> Result<P, SetupError>,
+    ) -> Result<CyclicTarget<'a, F, P>, SetupError> {
+        session.hello().map_err(SetupError::Usage)?;
+        let taken: Vec<String> = envs
+            .iter()
+            .filter(|e| session.takes(**e))
+            .map(env_kind)
+            .collect();
+        Ok(CyclicTarget {
+            session,
+            part: part(taken)?,
+        })
+    }
+}
+
+impl<'s, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> Target for CyclicTarget<'_, F, P> {
+    fn family(&self) -> FamilyId {
+        F::ID
+    }
+
+    fn describe(&self) -> String {
+        Session::describe(&self.session)
+    }
+
+    fn caps(&self) -> Caps {
+        CAPS
+    }
+
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
+        self.part.generate(rng)
+    }
+
+    fn fresh(&mut self) -> Result<Start, LinkError> {
+        // The case run resets both sides itself (and restarts a device that died).
+        Ok(Start::Fresh)
+    }
+
+    fn warm_up(&mut self) {}
+
+    fn run(&mut self, steps: &[Step]) -> Trial {
+        let (info, case) = self.part.case(steps);
+        let run = self.session.run_case(&info, &case);
+        let peer_error = self.session.take_peer_error();
+        trial(
+            run,
+            peer_error,
+            steps,
+            self.part.spec(),
+            P::own_kind,
+            |run, step| self.part.differs(run, step),
+        )
+    }
+
+    fn requirement(&self, id: &str) -> Option<RequirementRef> {
+        RequirementRef::of(self.part.spec(), id)
+    }
+
+    fn requirement_ids(&self) -> Vec<(String, Level)> {
+        engine::requirement_ids(self.part.spec())
     }
 }

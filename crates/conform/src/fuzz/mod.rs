@@ -225,7 +225,7 @@ fn with_target<R>(
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
                 None => suite.peer(&opts.dut)?,
             };
-            let mut target = crate::psd4xx::fuzz::Psd4xxTarget::new(&suite, peer)?;
+            let mut target = crate::psd4xx::fuzz::target(&suite, peer)?;
             f(&mut target)
         }
         FamilyId::Psx3xx => {
@@ -235,7 +235,7 @@ fn with_target<R>(
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
                 None => suite.peer(&opts.dut)?,
             };
-            let mut target = crate::psx3xx::fuzz::Psx3xxTarget::new(&suite, peer)?;
+            let mut target = crate::psx3xx::fuzz::target(&suite, peer)?;
             f(&mut target)
         }
     }
@@ -497,7 +497,7 @@ fn campaign(
             ),
         ];
         for (path, text) in files {
-            report::write_atomic(&path, &text).map_err(|e| FuzzError::Write {
+            drivespec_report::write_atomic(&path, &text).map_err(|e| FuzzError::Write {
                 file: path.display().to_string(),
                 why: e.to_string(),
             })?;

@@ -54,11 +54,10 @@ struct FuzzJson<'r> {
 
 /// The JSON report text.
 pub fn json(report: &Report, stats: &Stats) -> String {
-    serde_json::to_string_pretty(&FuzzJson {
+    drivespec_report::json(&FuzzJson {
         report,
         fuzz: stats,
     })
-    .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
 }
 
 /// What the report header says about the run.
@@ -212,7 +211,7 @@ pub(crate) fn build(
 
 /// The statistics as an HTML section.
 pub(crate) fn html_section(stats: &Stats) -> String {
-    let e = report::escape;
+    let e = drivespec_report::escape;
     let mut h = String::new();
     h.push_str("<h2>Fuzzing</h2>\n<table>");
     for (k, v) in [
@@ -234,7 +233,7 @@ pub(crate) fn html_section(stats: &Stats) -> String {
             let _ = writeln!(
                 h,
                 "<tr><td><a href=\"#{}\">{}</a></td><td class=\"fail\">{}</td><td><code>{}</code></td><td>{} (from {})</td><td>{}</td><td><code>{}</code></td></tr>",
-                f.id.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect::<String>(),
+                drivespec_report::html::anchor(&f.id),
                 e(&f.id),
                 f.class.as_str(),
                 e(&f.signature),

@@ -830,7 +830,7 @@ impl Replay {
 
     /// Writes the file atomically.
     pub fn save(&self, path: &Path) -> Result<(), ReplayError> {
-        crate::report::write_atomic(path, &self.to_json()).map_err(|e| ReplayError::Io {
+        drivespec_report::write_atomic(path, &self.to_json()).map_err(|e| ReplayError::Io {
             file: path.display().to_string(),
             why: e.to_string(),
         })

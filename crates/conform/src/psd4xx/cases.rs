@@ -48,34 +48,10 @@ pub(crate) enum Action {
 /// Most cycles a PKW command is repeated before the case moves on (PSD-PKW-002).
 pub(crate) const PKW_MAX_CYCLES: u32 = 8;
 
-/// One step: who it is for, one line, what it does.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct StepDef {
-    /// Setup, check or cleanup.
-    pub role: Role,
-    /// One line.
-    pub text: String,
-    /// What to do.
-    pub action: Action,
-}
+/// One step of a case.
+pub(crate) type StepDef = crate::cyclic_session::StepDef<Action>;
 
-/// Declared tolerances of a case (physics); everything else is exact.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub(crate) struct Tolerance {
-    /// A device sample may match a reference sample this many cycles earlier or later.
-    pub cycles: u32,
-    /// Actual position, increments.
-    pub position: i64,
-    /// Speed, rpm.
-    pub speed: i64,
-}
-
-/// Tolerance of the motion cases: ±3 cycles, ±20 increments, ±2 rpm.
-pub(crate) const MOTION: Tolerance = Tolerance {
-    cycles: 3,
-    position: 20,
-    speed: 2,
-};
+pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
 
 /// Tolerance of the PKW and record cases: the answer may come one cycle late.
 pub(crate) const EXCHANGE: Tolerance = Tolerance {

@@ -15,49 +15,55 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
+use crate::case::{CaseInfo, CaseRun, Role};
 use crate::cyclic::Peer;
-use crate::fuzz::cyclic_target;
-use crate::fuzz::engine::{self, Target, Trial};
-use crate::fuzz::replay::{Action, CyclicStep, Start, Step};
-use crate::link::{Caps, LinkError};
+use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
+use crate::fuzz::replay::{Action, CyclicStep, Step};
 use crate::psd4xx::cases::{self as cases, PsdCase, StepDef, EXCHANGE, MOTION};
-use crate::psd4xx::{Psd4xxSession, Psd4xxSuite};
+use crate::psd4xx::{Psd4xx, Psd4xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
 use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, PkwRequest};
 use drivespec_spec::hex::parse_hex;
-use drivespec_spec::{FamilyId, Level};
+use drivespec_spec::{Family, FamilyId, Level};
 use sequences::{PsdGen, ENV_KINDS};
 
 /// The PSD4xx target on one device under test.
-pub(crate) struct Psd4xxTarget<'a, 's> {
+pub(crate) type Psd4xxTarget<'a, 's> = CyclicTarget<'a, Psd4xx<'a, 's>, PsdFuzz<'a, 's>>;
+
+/// A target on `peer`, with the reference from `suite`.
+pub(crate) fn target<'a, 's>(
     suite: &'a Psd4xxSuite<'s>,
-    session: Psd4xxSession<'a, 's>,
+    peer: Box<dyn Peer + 'a>,
+) -> Result<Psd4xxTarget<'a, 's>, SetupError> {
+    CyclicTarget::new(suite.cyclic_session(peer), &ENV_KINDS, |envs| {
+        Ok(PsdFuzz {
+            suite,
+            gen: PsdGen::new(suite, envs).map_err(SetupError::Spec)?,
+        })
+    })
+}
+
+/// The PSD4xx sequences and their cases.
+pub(crate) struct PsdFuzz<'a, 's> {
+    suite: &'a Psd4xxSuite<'s>,
     gen: PsdGen,
 }
 
-impl<'a, 's> Psd4xxTarget<'a, 's> {
-    /// A target on `peer` (greeted with `HELLO`), with the reference from `suite`.
-    pub(crate) fn new(
-        suite: &'a Psd4xxSuite<'s>,
-        peer: Box<dyn Peer>,
-    ) -> Result<Psd4xxTarget<'a, 's>, SetupError> {
-        let mut session = suite.session(peer);
-        session.hello().map_err(SetupError::Usage)?;
-        // Only the injections the device takes are sent (they are optional).
-        let envs: Vec<String> = ENV_KINDS
-            .iter()
-            .filter(|e| session.takes(**e))
-            .map(cyclic_target::env_kind)
-            .collect();
-        let gen = PsdGen::new(suite, envs).map_err(SetupError::Spec)?;
-        Ok(Psd4xxTarget {
-            suite,
-            session,
-            gen,
-        })
+impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
+    type Family = Psd4xx<'a, 's>;
+
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
+        self.gen.sequence(rng)
+    }
+
+    fn own_kind(c: &CyclicStep) -> Option<String> {
+        own_kind(c)
+    }
+
+    fn spec(&self) -> &Family {
+        self.suite.family()
     }
 
     fn case(&self, steps: &[Step]) -> (CaseInfo, PsdCase) {
@@ -217,52 +223,5 @@ fn to_case_step(s: &Step) -> StepDef {
         role: Role::Check,
         text: s.text.clone(),
         action,
-    }
-}
-
-impl Target for Psd4xxTarget<'_, '_> {
-    fn family(&self) -> FamilyId {
-        FamilyId::Psd4xx
-    }
-
-    fn describe(&self) -> String {
-        crate::suite::Session::describe(&self.session)
-    }
-
-    fn caps(&self) -> Caps {
-        cyclic_target::CAPS
-    }
-
-    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
-        self.gen.sequence(rng)
-    }
-
-    fn fresh(&mut self) -> Result<Start, LinkError> {
-        // The case run resets both sides itself (and restarts a device that died).
-        Ok(Start::Fresh)
-    }
-
-    fn warm_up(&mut self) {}
-
-    fn run(&mut self, steps: &[Step]) -> Trial {
-        let (info, case) = self.case(steps);
-        let run = self.session.run_case(&info, &case);
-        let peer_error = self.session.take_peer_error();
-        cyclic_target::trial(
-            run,
-            peer_error,
-            steps,
-            self.suite.family(),
-            own_kind,
-            |run, step| self.differs(run, step),
-        )
-    }
-
-    fn requirement(&self, id: &str) -> Option<RequirementRef> {
-        RequirementRef::of(self.suite.family(), id)
-    }
-
-    fn requirement_ids(&self) -> Vec<(String, Level)> {
-        engine::requirement_ids(self.suite.family())
     }
 }

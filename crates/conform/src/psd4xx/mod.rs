@@ -21,12 +21,11 @@ pub(crate) mod cases;
 pub(crate) mod fuzz;
 mod session;
 
-pub use session::Psd4xxSession;
+pub(crate) use session::{Psd4xx, Psd4xxSession};
 
 use crate::case::CaseInfo;
-use crate::cyclic::{LinkPeer, LocalPeer, Peer, Server};
+use crate::cyclic::{Peer, Server};
 use crate::dut::Dut;
-use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, Settings, SetupError, Suite};
 use cases::PsdCase;
 use drivespec_psd4xx::model::Drive;
@@ -78,8 +77,13 @@ impl<'s> Psd4xxSuite<'s> {
     }
 
     /// Opens a session on a peer of the caller's (tests, embedding tools).
-    pub fn session(&self, peer: Box<dyn Peer>) -> Psd4xxSession<'_, 's> {
-        Psd4xxSession::new(self, peer)
+    pub fn session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> impl Session + 'a {
+        self.cyclic_session(peer)
+    }
+
+    /// A session on `peer` with the family's own operations (greeting, injections, fuzzing).
+    pub(crate) fn cyclic_session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psd4xxSession<'a, 's> {
+        Psd4xxSession::new(Psd4xx::new(self), peer)
     }
 
     pub(crate) fn family(&self) -> &'s Family {
@@ -91,35 +95,7 @@ impl<'s> Psd4xxSuite<'s> {
     }
 
     pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
-        // Real peers get 2 s per reply (a process may take a while to start).
-        const TIMEOUT_US: u64 = 2_000_000;
-        Ok(match dut {
-            Dut::Sim { .. } => Box::new(LocalPeer::new(
-                &format!("sim:{}", self.reference.model.id),
-                self.server(),
-            )),
-            Dut::Serial { path, baud } => {
-                // The cyclic protocol is plain text: 8N1.
-                let character = drivespec_spec::hpd::CharacterFormat {
-                    source: "drivespec-cyclic/1".to_owned(),
-                    start_bits: 1,
-                    data_bits: 8,
-                    parity: drivespec_spec::hpd::Parity::None,
-                    stop_bits: 1,
-                    bits_per_char: 10,
-                };
-                Box::new(LinkPeer::new(
-                    Box::new(SerialLink::open(path, baud.unwrap_or(115_200), &character)?),
-                    TIMEOUT_US,
-                ))
-            }
-            Dut::Tcp { addr } => {
-                Box::new(LinkPeer::new(Box::new(TcpLink::connect(addr)?), TIMEOUT_US))
-            }
-            Dut::Exec { argv } => {
-                Box::new(LinkPeer::new(Box::new(ExecLink::spawn(argv)?), TIMEOUT_US))
-            }
-        })
+        crate::cyclic_session::peer(dut, &self.reference.model.id, self.server())
     }
 }
 
@@ -134,7 +110,7 @@ impl Suite for Psd4xxSuite<'_> {
 
     fn open(&self, dut: &Dut) -> Result<Box<dyn Session + '_>, SetupError> {
         let peer = self.peer(dut)?;
-        let mut s = self.session(peer);
+        let mut s = self.cyclic_session(peer);
         s.hello().map_err(SetupError::Usage)?;
         Ok(Box::new(s))
     }

@@ -15,61 +15,63 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, RequirementRef, Role};
+use crate::case::{CaseInfo, CaseRun, Role};
 use crate::cyclic::Peer;
-use crate::fuzz::cyclic_target;
-use crate::fuzz::engine::{self, Target, Trial};
-use crate::fuzz::replay::{Action, CyclicStep, Start, Step};
-use crate::link::{Caps, LinkError};
+use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
+use crate::fuzz::replay::{Action, CyclicStep, Step};
 use crate::psx3xx::cases::{self as cases, PsxCase, StepDef, EXACT, MOTION};
-use crate::psx3xx::{Psx3xxSession, Psx3xxSuite};
+use crate::psx3xx::{Psx3xx, Psx3xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
 use drivespec_psx3xx::isdu::Request as IsduRequest;
 use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
 use drivespec_spec::hex::parse_hex;
-use drivespec_spec::{FamilyId, Level};
+use drivespec_spec::{Family, FamilyId, Level};
 use sequences::{PsxGen, ENV_KINDS};
 
 /// The PSx3xx target on one device under test.
-pub(crate) struct Psx3xxTarget<'a, 's> {
-    suite: &'a Psx3xxSuite<'s>,
-    session: Psx3xxSession<'a, 's>,
-    gen: PsxGen<'s>,
-    /// ISDU indices whose writes may move the drive: the commands (ISDU 2, 193) and the
-    /// control word and target of the time-stamp format (ISDU 110, 112).
-    moving: Vec<u16>,
-}
+pub(crate) type Psx3xxTarget<'a, 's> = CyclicTarget<'a, Psx3xx<'a, 's>, PsxFuzz<'a, 's>>;
 
-impl<'a, 's> Psx3xxTarget<'a, 's> {
-    /// A target on `peer` (greeted with `HELLO`), with the reference from `suite`.
-    pub(crate) fn new(
-        suite: &'a Psx3xxSuite<'s>,
-        peer: Box<dyn Peer + 'a>,
-    ) -> Result<Psx3xxTarget<'a, 's>, SetupError> {
-        let mut session = suite.session(peer);
-        session.hello().map_err(SetupError::Usage)?;
-        // Only the injections the device takes are sent (they are optional).
-        let envs: Vec<String> = ENV_KINDS
-            .iter()
-            .filter(|e| session.takes(**e))
-            .map(cyclic_target::env_kind)
-            .collect();
+/// A target on `peer`, with the reference from `suite`.
+pub(crate) fn target<'a, 's>(
+    suite: &'a Psx3xxSuite<'s>,
+    peer: Box<dyn Peer + 'a>,
+) -> Result<Psx3xxTarget<'a, 's>, SetupError> {
+    CyclicTarget::new(suite.cyclic_session(peer), &ENV_KINDS, |envs| {
         let gen = PsxGen::new(suite, envs).map_err(SetupError::Spec)?;
-        let rules = suite.reference().rules();
-        let ts = rules.timestamp();
+        let ts = suite.reference().rules().timestamp();
         let family = suite.family();
         let moving = ["2", "193", &ts.control_word_param, &ts.target_param]
             .iter()
             .filter_map(|id| family.parameters.iter().find(|p| p.id == *id))
             .filter_map(|p| u16::try_from(p.number).ok())
             .collect();
-        Ok(Psx3xxTarget {
-            suite,
-            session,
-            gen,
-            moving,
-        })
+        Ok(PsxFuzz { suite, gen, moving })
+    })
+}
+
+/// The PSx3xx sequences and their cases.
+pub(crate) struct PsxFuzz<'a, 's> {
+    suite: &'a Psx3xxSuite<'s>,
+    gen: PsxGen<'s>,
+    /// ISDU indices whose writes may move the drive: the commands (ISDU 2, 193) and the
+    /// control word and target of the time-stamp format (ISDU 110, 112).
+    moving: Vec<u16>,
+}
+
+impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
+    type Family = Psx3xx<'a, 's>;
+
+    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
+        self.gen.sequence(rng)
+    }
+
+    fn own_kind(c: &CyclicStep) -> Option<String> {
+        own_kind(c)
+    }
+
+    fn spec(&self) -> &Family {
+        self.suite.family()
     }
 
     fn case(&self, steps: &[Step]) -> (CaseInfo, PsxCase) {
@@ -234,52 +236,5 @@ fn to_case_step(s: &Step) -> StepDef {
         role: Role::Check,
         text: s.text.clone(),
         action,
-    }
-}
-
-impl Target for Psx3xxTarget<'_, '_> {
-    fn family(&self) -> FamilyId {
-        FamilyId::Psx3xx
-    }
-
-    fn describe(&self) -> String {
-        crate::suite::Session::describe(&self.session)
-    }
-
-    fn caps(&self) -> Caps {
-        cyclic_target::CAPS
-    }
-
-    fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
-        self.gen.sequence(rng)
-    }
-
-    fn fresh(&mut self) -> Result<Start, LinkError> {
-        // The case run resets both sides itself (and restarts a device that died).
-        Ok(Start::Fresh)
-    }
-
-    fn warm_up(&mut self) {}
-
-    fn run(&mut self, steps: &[Step]) -> Trial {
-        let (info, case) = self.case(steps);
-        let run = self.session.run_case(&info, &case);
-        let peer_error = self.session.take_peer_error();
-        cyclic_target::trial(
-            run,
-            peer_error,
-            steps,
-            self.suite.family(),
-            own_kind,
-            |run, step| self.differs(run, step),
-        )
-    }
-
-    fn requirement(&self, id: &str) -> Option<RequirementRef> {
-        RequirementRef::of(self.suite.family(), id)
-    }
-
-    fn requirement_ids(&self) -> Vec<(String, Level)> {
-        engine::requirement_ids(self.suite.family())
     }
 }

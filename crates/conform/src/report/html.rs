@@ -2,7 +2,10 @@
 //! requirement coverage matrix (requirement → cases → verdict) and every case with its
 //! evidence; failing cases are listed first and open.
 
-use super::{escape, CaseReport, Coverage, Report, Status};
+use super::{CaseReport, Coverage, Report, Status};
+use drivespec_report::escape;
+use drivespec_report::html::anchor;
+use drivespec_report::plot;
 use std::fmt::Write as _;
 
 const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;margin:2em;color:#222}\
@@ -125,12 +128,6 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
     h
 }
 
-fn anchor(id: &str) -> String {
-    id.chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
-        .collect()
-}
-
 fn case(h: &mut String, c: &CaseReport) {
     let open = if c.status == Status::Fail {
         " open"
@@ -184,12 +181,8 @@ fn case(h: &mut String, c: &CaseReport) {
         escape(&c.requirements.join(", "))
     );
     // Positioning cases: position/speed/status over time, reference vs device (inline SVG).
-    for e in c
-        .evidence
-        .iter()
-        .filter(|e| e.action == crate::plot::ACTION)
-    {
-        if let Some(svg) = e.note.as_deref().and_then(crate::plot::svg) {
+    for e in c.evidence.iter().filter(|e| e.action == plot::ACTION) {
+        if let Some(svg) = e.note.as_deref().and_then(plot::svg) {
             let _ = writeln!(h, "<p>{svg}</p>");
         }
     }

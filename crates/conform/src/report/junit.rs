@@ -3,7 +3,8 @@
 //! carry `message` and a text with expected vs got, the requirements, the exchange and the
 //! replay command; skipped and known failures are `<skipped>`.
 
-use super::{escape, CaseReport, Report, Status};
+use super::{CaseReport, Report, Status};
+use drivespec_report::junit::{Case, Document, Form, Outcome, Suite};
 use std::fmt::Write as _;
 
 /// The report as JUnit XML.
@@ -14,120 +15,74 @@ pub fn junit(r: &Report) -> String {
 /// The report as JUnit XML under the name `tool` (`drivespec fuzz`), with `properties` added
 /// to each test suite's properties.
 pub fn junit_with(r: &Report, tool: &str, properties: &[(String, String)]) -> String {
-    let mut x = String::new();
-    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    let time = |cases: &[&CaseReport]| cases.iter().map(|c| c.wall_ms).sum::<f64>() / 1000.0;
-    let all: Vec<&CaseReport> = r.cases.iter().collect();
-    let fails = |cases: &[&CaseReport]| cases.iter().filter(|c| c.status == Status::Fail).count();
-    let skips = |cases: &[&CaseReport]| {
-        cases
-            .iter()
-            .filter(|c| {
-                matches!(
-                    c.status,
-                    Status::Skipped | Status::NotRun | Status::ExpectedFailure
-                )
-            })
-            .count()
-    };
-    let _ = writeln!(
-        x,
-        "<testsuites name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"{}\" time=\"{:.3}\">",
-        escape(tool),
-        all.len(),
-        fails(&all),
-        skips(&all),
-        time(&all)
-    );
-    for family in &r.run.families {
-        let cases: Vec<&CaseReport> = r.cases.iter().filter(|c| c.family == *family).collect();
-        let _ = writeln!(
-            x,
-            "  <testsuite name=\"{family}\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"{}\" time=\"{:.3}\">",
-            cases.len(),
-            fails(&cases),
-            skips(&cases),
-            time(&cases)
-        );
-        x.push_str("    <properties>\n");
-        for (k, v) in [
-            ("dut", r.run.dut.clone()),
-            ("transport", r.run.transport.clone()),
-            ("seed", r.run.seed.to_string()),
-            ("address", r.run.address.to_string()),
-        ] {
-            let _ = writeln!(x, "      <property name=\"{k}\" value=\"{}\"/>", escape(&v));
-        }
-        for (k, v) in properties {
-            let _ = writeln!(
-                x,
-                "      <property name=\"{}\" value=\"{}\"/>",
-                escape(k),
-                escape(v)
-            );
-        }
-        x.push_str("    </properties>\n");
-        for c in cases {
-            case(&mut x, c);
-        }
-        x.push_str("  </testsuite>\n");
+    let suites = r
+        .run
+        .families
+        .iter()
+        .map(|family| {
+            let mut props: Vec<(String, String)> = vec![
+                ("dut".to_owned(), r.run.dut.clone()),
+                ("transport".to_owned(), r.run.transport.clone()),
+                ("seed".to_owned(), r.run.seed.to_string()),
+                ("address".to_owned(), r.run.address.to_string()),
+            ];
+            props.extend(properties.iter().cloned());
+            Suite {
+                name: family.to_string(),
+                properties: props,
+                cases: r
+                    .cases
+                    .iter()
+                    .filter(|c| c.family == *family)
+                    .map(case)
+                    .collect(),
+            }
+        })
+        .collect();
+    Document {
+        name: tool.to_owned(),
+        form: Form::Timed,
+        suites,
     }
-    x.push_str("</testsuites>\n");
-    x
+    .to_xml()
 }
 
-fn case(x: &mut String, c: &CaseReport) {
+fn case(c: &CaseReport) -> Case {
     let mut parts = c.id.split('/');
     let classname = match (parts.next(), parts.next()) {
         (Some(f), Some(g)) => format!("{f}.{g}"),
         (Some(f), None) => f.to_owned(),
         _ => String::new(),
     };
-    let _ = write!(
-        x,
-        "    <testcase name=\"{}\" classname=\"{}\" time=\"{:.3}\"",
-        escape(&c.id),
-        escape(&classname),
-        c.wall_ms / 1000.0
-    );
-    match c.status {
-        Status::Pass => x.push_str("/>\n"),
-        Status::Fixed => {
-            let _ = writeln!(
-                x,
-                ">\n      <system-out>{}</system-out>\n    </testcase>",
-                escape(&format!(
-                    "passes although the expectations file lists it as a known failure ({}); remove the entry",
-                    c.expectation.as_deref().unwrap_or("")
-                ))
-            );
-        }
-        Status::Skipped | Status::NotRun | Status::ExpectedFailure => {
-            let msg = match c.status {
-                Status::ExpectedFailure => {
-                    format!("known failure: {}", c.expectation.as_deref().unwrap_or(""))
-                }
-                Status::NotRun => "not run: --fail-fast stopped the run".to_owned(),
-                _ => c.skip_reason.clone().unwrap_or_default(),
-            };
-            let _ = writeln!(
-                x,
-                ">\n      <skipped message=\"{}\"/>\n    </testcase>",
-                escape(&msg)
-            );
-        }
+    let outcome = match c.status {
+        Status::Pass => Outcome::Passed,
+        Status::Fixed => Outcome::PassedWithOutput(format!(
+            "passes although the expectations file lists it as a known failure ({}); remove the entry",
+            c.expectation.as_deref().unwrap_or("")
+        )),
+        Status::ExpectedFailure => Outcome::Skipped(format!(
+            "known failure: {}",
+            c.expectation.as_deref().unwrap_or("")
+        )),
+        Status::NotRun => Outcome::Skipped("not run: --fail-fast stopped the run".to_owned()),
+        Status::Skipped => Outcome::Skipped(c.skip_reason.clone().unwrap_or_default()),
         Status::Fail => {
-            let (message, body) = match &c.failure {
+            let (message, text) = match &c.failure {
                 Some(f) => (f.message.clone(), failure_text(c)),
                 None => ("failed".to_owned(), String::new()),
             };
-            let _ = writeln!(
-                x,
-                ">\n      <failure message=\"{}\" type=\"mismatch\">{}</failure>\n    </testcase>",
-                escape(&message),
-                escape(&body)
-            );
+            Outcome::Failed {
+                message,
+                kind: "mismatch".to_owned(),
+                text: Some(text),
+            }
         }
+    };
+    Case {
+        name: c.id.clone(),
+        classname,
+        time_ms: c.wall_ms,
+        outcome,
     }
 }
 

@@ -1,7 +1,6 @@
 //! The run report: one data model (serialised as the JSON report, schema in
 //! `crates/conform/README.md`, "JSON report"), rendered as JUnit XML and as a self-contained
-//! HTML page. Files are written atomically: to a temporary file in the same folder, flushed,
-//! then renamed over the target, so a reader never sees half a report.
+//! HTML page with the `drivespec-report` formats.
 
 mod html;
 mod junit;
@@ -12,8 +11,6 @@ pub use junit::{junit, junit_with};
 use crate::case::{Failure, Record};
 use drivespec_spec::{FamilyId, Level};
 use serde::Serialize;
-use std::io::Write;
-use std::path::Path;
 
 /// Name and version of the JSON schema (`crates/conform/README.md`, "JSON report").
 pub const SCHEMA: &str = "drivespec-conform/1";
@@ -200,78 +197,6 @@ pub struct CaseRef {
 impl Report {
     /// The JSON report.
     pub fn json(&self) -> String {
-        serde_json::to_string_pretty(self)
-            .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
-    }
-}
-
-/// Writes `text` to `path` atomically (temporary file in the same folder, then rename).
-pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "report".to_owned());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
-/// Escapes text for XML and HTML.
-pub(crate) fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            // Characters XML 1.0 does not allow.
-            c if (c as u32) < 0x20 && !matches!(c, '\n' | '\r' | '\t') => out.push('\u{FFFD}'),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn atomic_write_replaces_and_leaves_no_temp() {
-        let dir = std::env::temp_dir().join(format!("conform-report-{}", std::process::id()));
-        let path = dir.join("r.json");
-        write_atomic(&path, "one").unwrap();
-        write_atomic(&path, "two").unwrap();
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), "two");
-        let names: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name())
-            .collect();
-        assert_eq!(names.len(), 1, "{names:?}");
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn escaping() {
-        assert_eq!(
-            escape("a<b>&\"'\u{1}"),
-            "a&lt;b&gt;&amp;&quot;&apos;\u{FFFD}"
-        );
+        drivespec_report::json(self)
     }
 }

@@ -1,8 +1,9 @@
 //! The position/speed/status plot of a positioning case (PSD4xx and PSx3xx): the samples
-//! travel in the evidence
-//! (a cleanup record with action [`ACTION`], at most [`MAX_POINTS`] samples as text in its
-//! note) and the HTML report draws them as a small inline SVG with [`svg`].
+//! travel in the evidence (a cleanup record with action [`ACTION`], at most [`MAX_POINTS`]
+//! samples as text in its note) and the HTML report draws them as a small inline SVG with
+//! [`svg`].
 
+use crate::svg::polyline;
 use std::fmt::Write as _;
 
 /// Action of the evidence record that carries the plot data.
@@ -65,17 +66,6 @@ pub fn decode(text: &str) -> Option<Vec<Sample>> {
             })
         })
         .collect()
-}
-
-fn polyline(points: &[(f64, f64)], style: &str) -> String {
-    let mut s = String::from("<polyline fill=\"none\" ");
-    s.push_str(style);
-    s.push_str(" points=\"");
-    for (x, y) in points {
-        let _ = write!(s, "{x:.1},{y:.1} ");
-    }
-    s.push_str("\"/>");
-    s
 }
 
 /// An inline SVG (about 2 KB) of the plot data in `note`; None when `note` is not plot data.
