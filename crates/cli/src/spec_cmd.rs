@@ -3,7 +3,7 @@
 use crate::{json, Context, Format, Outcome};
 use anyhow::{anyhow, bail, Result};
 use clap::{Args, Subcommand};
-use drivespec_spec::{DeviceModel, Family, FamilyId, Level, Parameter, Ranges, Spec};
+use drivespec_spec::{DeviceModel, Family, FamilyId, Level, Parameter, Problem, Ranges, Spec};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -125,10 +125,18 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
         record: Option<&'a str>,
         message: String,
     }
-    let (ok, problems) = match &loaded {
-        Ok(_) => (true, Vec::new()),
-        Err(e) => (false, e.0.iter().collect()),
+    let steps: Vec<Problem> = match &loaded {
+        Ok(spec) => drivespec_psd4xx::step::check_steps(spec)
+            .into_iter()
+            .chain(drivespec_psx3xx::step::check_steps(spec))
+            .collect(),
+        Err(_) => Vec::new(),
     };
+    let problems: Vec<&Problem> = match &loaded {
+        Ok(_) => steps.iter().collect(),
+        Err(e) => e.0.iter().collect(),
+    };
+    let ok = problems.is_empty();
     match format {
         Format::Json => {
             let report = Report {
@@ -148,7 +156,7 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
             for p in &problems {
                 println!("{p}");
             }
-            if let Ok(spec) = &loaded {
+            if let (Ok(spec), true) = (&loaded, ok) {
                 for f in spec.families() {
                     println!(
                         "{}: {} parameters, {} models, {} bitfields, {} requirements, {} errata, {} vectors",

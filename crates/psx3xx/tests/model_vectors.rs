@@ -115,7 +115,7 @@ fn check(s: &mut Sim, expect: &toml::Table, started: &mut Option<Vec<i64>>) -> R
             return Err(format!("status bit {b} not set ({:#06x})", s.status()));
         }
     }
-    for b in list(expect.get("status_reset")) {
+    for b in list(expect.get("status_clear")) {
         if s.bit(b as u32) {
             return Err(format!("status bit {b} not reset ({:#06x})", s.status()));
         }
