@@ -278,7 +278,7 @@ pub struct Expect {
     /// The jog state is checked this many ms after the keys are pressed.
     #[serde(default)]
     pub after_ms: Option<u64>,
-    /// Where a run stops.
+    /// A forward jog ends here at the latest (the upper limit).
     #[serde(default)]
     pub stop_at: Option<i64>,
     /// The direction a jog moves.

@@ -141,6 +141,11 @@ fn check(s: &mut Sim, expect: &Expect, started: &mut Option<Vec<i64>>) -> Result
             ));
         }
     }
+    if let Some(active) = expect.keys_active {
+        if s.run().starts_with("jog") != active {
+            return Err(format!("keys active {active}, run {}", s.run()));
+        }
+    }
     if let Some(f) = expect.active_format {
         if s.drive.active_format() != f {
             return Err(format!("active format {}", s.drive.active_format()));
@@ -289,6 +294,12 @@ fn step(s: &mut Sim, st: &Step, started: &mut Option<Vec<i64>>) -> Result<(), St
         }
         s.keys(JogKeys::NONE);
         s.settle(60_000);
+        if let Some(at) = expect.stop_at {
+            // A forward jog ends at the limit at the latest.
+            if s.actual() > at {
+                return Err(format!("jog ended at {} beyond {at}", s.actual()));
+            }
+        }
     }
     if let Some(d) = expect.direction {
         let moved = s.drive.core().run_target().unwrap_or(before) - before;
