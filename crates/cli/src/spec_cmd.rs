@@ -129,8 +129,20 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
     }
     let loaded = loaded.map(Arc::new);
     let (problems, built) = match &loaded {
-        Ok(spec) => (Vec::new(), spec_build::problems(spec)),
-        Err(e) => (e.0.iter().collect(), Vec::new()),
+        Ok(spec) => {
+            let steps: Vec<_> = drivespec_psd4xx::step::check_steps(spec)
+                .into_iter()
+                .chain(drivespec_psx3xx::step::check_steps(spec))
+                .collect();
+            // Suites and simulators are built from a spec whose steps read.
+            let built = if steps.is_empty() {
+                spec_build::problems(spec)
+            } else {
+                Vec::new()
+            };
+            (steps, built)
+        }
+        Err(e) => (e.0.clone(), Vec::new()),
     };
     let ok = problems.is_empty() && built.is_empty();
     match format {

@@ -95,6 +95,51 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
     assert_eq!(code, 2);
 }
 
+/// A misspelt key in a step of a `sequence` vector fails `spec check` naming file, record,
+/// step and key, in each cyclic family.
+#[test]
+fn misspelt_step_key_fails_check_naming_file_record_and_key() {
+    let dir = std::env::temp_dir().join(format!("drivespec-steps-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec");
+    copy_dir(std::path::Path::new(src), &dir);
+    let edit = |file: &str, from: &str, to: &str| {
+        let path = dir.join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text.matches(from).count(), 1, "{from}");
+        std::fs::write(&path, text.replace(from, to)).unwrap();
+    };
+    edit(
+        "psd4xx/vectors/process.toml",
+        "target_offset = 100",
+        "target_ofset = 100",
+    );
+    edit(
+        "psx3xx/vectors/process.toml",
+        "index = 112, value = 70000 }, expect = { run = \"positioning\", target = 70000, stop = false",
+        "index = 112, value = 70000 }, expect = { run = \"positioning\", target = 70000, stopp = false",
+    );
+    let (code, stdout, stderr) = run(BIN, &["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    assert!(
+        lines[0].starts_with(
+            "psd4xx/vectors/process.toml: vector \"seq-loop-case-3-short\": input.steps[3]: unknown field `target_ofset`"
+        ),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[1].starts_with(
+            "psx3xx/vectors/process.toml: vector \"seq-ts-new-target-during-run\": input.steps[2]: unknown field `stopp`"
+        ),
+        "{}",
+        lines[1]
+    );
+}
+
 #[test]
 fn check_json_is_machine_readable() {
     let (code, stdout, _) = run(BIN, &["spec", "check", "--format", "json"]);

@@ -22,6 +22,8 @@
 //! - [`config`]: the family description ([`CoreConfig`]).
 //! - [`machine`]: the state machine ([`Positioner`]): runs, reference loop, faults, status.
 //! - [`script`]: the `sim-run` script grammar, expectations and traces every family shares.
+//! - [`step`]: the start state, waits and typed reading of the `sequence` vectors every
+//!   cyclic family shares.
 //!
 //! Guarantees: nothing here panics on any input, and nothing touches a port, a socket or the
 //! clock. Allocation is bounded by the spec tables (names) and by the width of a word
@@ -42,6 +44,7 @@ pub mod machine;
 pub mod profile;
 pub mod script;
 pub mod status;
+pub mod step;
 
 pub use bits::{decode_bits, BitsDecoded, NamedWord, SetBit};
 pub use code::{CodeEntry, CodeTable, CodeTableError, Named, WireCode};

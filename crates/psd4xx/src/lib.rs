@@ -31,6 +31,7 @@ pub mod record;
 mod repr;
 mod rules;
 pub mod script;
+pub mod step;
 mod value;
 pub mod wire;
 

@@ -11,8 +11,10 @@
 
 mod model_util;
 
+use drivespec_positioner::step::{read_sequence, Wait};
 use drivespec_positioner::EnvChange;
 use drivespec_psd4xx::model::{DriveConfig, LinkEvent, RecordAnswer, RecordRequest};
+use drivespec_psd4xx::step::{Direction, Event, PsdSequence};
 use drivespec_psd4xx::{Output, Pkw, PkwRequest, PkwResponse};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{IntOrText, Vector, VectorKind, VectorResult};
@@ -25,17 +27,6 @@ const DEFAULT_MODEL: &str = "PSD401-5V";
 
 fn vectors(kind: VectorKind) -> Vec<&'static Vector> {
     family().vectors.iter().filter(|v| v.kind == kind).collect()
-}
-
-fn int(v: &toml::Value) -> i64 {
-    v.as_integer().unwrap()
-}
-
-fn ints(t: &toml::Table, key: &str) -> Vec<u32> {
-    t.get(key)
-        .and_then(toml::Value::as_array)
-        .map(|a| a.iter().map(|x| int(x) as u32).collect())
-        .unwrap_or_default()
 }
 
 /// A drive set up with a vector's `state`: "3" places the shaft, "13" names the model string,
@@ -98,56 +89,49 @@ fn reach_speed(s: &mut Sim, rpm: i64) {
 
 fn run_sequence(v: &Vector) {
     let id = &v.id;
-    let body = v.sequence().unwrap();
-    let state: Option<BTreeMap<String, IntOrText>> = body
-        .input
-        .get("state")
+    let seq: PsdSequence = read_sequence(v).unwrap_or_else(|e| panic!("{id}: {e}"));
+    let state: Option<BTreeMap<String, IntOrText>> = v
+        .sequence()
+        .and_then(|b| b.input.get("state"))
         .map(|t| t.clone().try_into().unwrap());
     let mut s = setup(v, state.as_ref());
     let window = s.par(44);
-    let steps = body
-        .input
-        .get("steps")
-        .and_then(toml::Value::as_array)
-        .unwrap();
-    for (n, step) in steps.iter().enumerate() {
-        let step = step.as_table().unwrap();
+    for (n, step) in seq.input.steps.iter().enumerate() {
         let at = |s: &Sim, what: &str| format!("{id} step {n}: {what}; {}", s.describe());
         let start = s.actual();
         let mut jammed = false;
-        match step.get("event").and_then(toml::Value::as_str) {
+        match step.event {
             None => {}
-            Some("power-on") => s.drive.power_cycle(s.now),
-            Some("obstruction-detected") => {
+            Some(Event::PowerOn) => s.drive.power_cycle(s.now),
+            Some(Event::ObstructionDetected) => {
                 s.env(EnvChange::Jam { on: true });
                 jammed = true;
             }
-            Some("manual-rotation-at-standstill") => {
-                let d = step.get("distance").map(int).unwrap();
-                let by = match step.get("direction").and_then(toml::Value::as_str) {
-                    Some("decreasing") => -d,
+            Some(Event::ManualRotationAtStandstill) => {
+                let d = step.distance.unwrap();
+                let by = match step.direction {
+                    Some(Direction::Decreasing) => -d,
                     _ => d,
                 };
                 s.env(EnvChange::Displace { by });
             }
-            Some("motor-voltage-out-of-range") => s.env(EnvChange::MotorVoltage { dv: 100 }),
-            Some("motor-voltage-in-range") => s.env(EnvChange::MotorVoltage { dv: 240 }),
-            Some("position-outside-window-after-run") => {
+            Some(Event::MotorVoltageOutOfRange) => s.env(EnvChange::MotorVoltage { dv: 100 }),
+            Some(Event::MotorVoltageInRange) => s.env(EnvChange::MotorVoltage { dv: 240 }),
+            Some(Event::PositionOutsideWindowAfterRun) => {
                 s.env(EnvChange::MissSteps { by: window + 1 })
             }
-            Some("connection-interrupted") => s.link(LinkEvent::Lost),
-            Some("connection-restored") => s.link(LinkEvent::Connected),
-            Some("iops-bad") => s.link(LinkEvent::IopsBad),
-            Some(other) => panic!("{}", at(&s, &format!("unknown event {other}"))),
+            Some(Event::ConnectionInterrupted) => s.link(LinkEvent::Lost),
+            Some(Event::ConnectionRestored) => s.link(LinkEvent::Connected),
+            Some(Event::IopsBad) => s.link(LinkEvent::IopsBad),
         }
-        if let Some(c) = step.get("control") {
-            s.control = int(c) as u16;
+        if let Some(c) = step.control {
+            s.control = c;
         }
-        if let Some(t) = step.get("target") {
-            s.target = int(t) as i32;
+        if let Some(t) = step.target {
+            s.target = t;
         }
-        if let Some(o) = step.get("target_offset") {
-            s.target = (start + int(o)) as i32;
+        if let Some(o) = step.target_offset {
+            s.target = (start + o) as i32;
         }
         s.cycle();
         let mut min = s.actual();
@@ -158,15 +142,15 @@ fn run_sequence(v: &Vector) {
                 dropped |= !s.idle();
             }
         };
-        match step.get("wait").and_then(toml::Value::as_str) {
-            Some("running") => {
+        match step.wait {
+            Wait::Running => {
                 let ok = s.until(10_000, |s| {
                     track(s);
                     s.running()
                 });
                 assert!(ok, "{}", at(&s, "never running"));
             }
-            Some("standstill") => {
+            Wait::Standstill => {
                 let ok = s.until(600_000, |s| {
                     track(s);
                     s.idle()
@@ -174,48 +158,42 @@ fn run_sequence(v: &Vector) {
                 assert!(ok, "{}", at(&s, "never at standstill"));
                 s.step(1);
             }
-            Some("settle") => {
+            Wait::Settle => {
                 for _ in 0..500 {
                     s.step(1);
                     track(&s);
                 }
             }
-            other => panic!("{}", at(&s, &format!("unknown wait {other:?}"))),
         }
         if jammed {
             s.env(EnvChange::Jam { on: false });
         }
-        for b in ints(step, "status_set") {
+        for &b in &step.status_set {
             assert!(s.bit(b), "{}", at(&s, &format!("bit {b} should be set")));
         }
-        for b in ints(step, "status_clear") {
+        for &b in &step.status_clear {
             assert!(!s.bit(b), "{}", at(&s, &format!("bit {b} should be clear")));
         }
-        if let Some(a) = step.get("actual") {
-            let want = int(a);
+        if let Some(want) = step.actual {
             assert!(
                 s.actual().abs_diff(want) <= window as u64,
                 "{}",
                 at(&s, &format!("actual should be {want}"))
             );
         }
-        if let Some(m) = step.get("min_position") {
-            assert_eq!(min, int(m), "{}", at(&s, "lowest position passed"));
+        if let Some(m) = step.min_position {
+            assert_eq!(min, m, "{}", at(&s, "lowest position passed"));
         }
-        if let Some(m) = step.get("min_position_offset") {
-            assert_eq!(min - start, int(m), "{}", at(&s, "lowest position passed"));
+        if let Some(m) = step.min_position_offset {
+            assert_eq!(min - start, m, "{}", at(&s, "lowest position passed"));
         }
-        if step
-            .get("no_intermediate_standstill")
-            .and_then(toml::Value::as_bool)
-            == Some(true)
-        {
+        if step.no_intermediate_standstill == Some(true) {
             assert!(!dropped, "{}", at(&s, "the drive stopped in between"));
         }
     }
-    if let Some(a) = body.expect.get("actual") {
+    if let Some(a) = seq.expect.actual {
         assert!(
-            s.actual().abs_diff(int(a)) <= window as u64,
+            s.actual().abs_diff(a) <= window as u64,
             "{id}: final actual"
         );
     }

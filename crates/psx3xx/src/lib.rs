@@ -42,6 +42,7 @@ pub mod model;
 pub mod repr;
 pub mod rules;
 pub mod script;
+pub mod step;
 pub mod timestamp;
 pub mod wire;
 

@@ -8,7 +8,7 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use crate::case::{CaseInfo, CaseRun, Failure, Outcome, RequirementRef, Role};
 use crate::fuzz::engine::{self, Fault, Target, Trial};
 use crate::fuzz::replay::{Action, Compare, FindingClass, Start, Step};
 use crate::hpd::step::{Action as HAction, Compare as HCompare, HpdCase, Step as HStep};
@@ -60,8 +60,12 @@ impl<'a, 's> HpdTarget<'a, 's> {
         })
     }
 
-    fn case(&self, steps: &[Step]) -> (CaseInfo, HpdCase) {
-        let hsteps: Vec<HStep> = steps.iter().map(to_hpd).collect();
+    fn case(&self, steps: &[Step]) -> Result<(CaseInfo, HpdCase), NotHpdStep> {
+        let hsteps = steps
+            .iter()
+            .enumerate()
+            .map(|(index, s)| to_hpd(s).ok_or_else(|| NotHpdStep::new(index, s)))
+            .collect::<Result<Vec<HStep>, NotHpdStep>>()?;
         let info = CaseInfo {
             id: "hpd/fuzz/sequence".to_owned(),
             family: FamilyId::Hpd,
@@ -75,7 +79,7 @@ impl<'a, 's> HpdTarget<'a, 's> {
             touched: self.touched(steps),
             steps: hsteps,
         };
-        (info, case)
+        Ok((info, case))
     }
 
     /// Parameter slots the steps may change (read back after a failure on transports that
@@ -113,9 +117,13 @@ impl<'a, 's> HpdTarget<'a, 's> {
         out
     }
 
+    /// Runs the steps as one case; a step of another family fails the run with
+    /// [`NotHpdStep`] before anything is sent.
     fn run_raw(&mut self, steps: &[Step]) -> CaseRun {
-        let (info, case) = self.case(steps);
-        self.session.run_case(&info, &case, false)
+        match self.case(steps) {
+            Ok((info, case)) => self.session.run_case(&info, &case, false),
+            Err(e) => e.failed_run(),
+        }
     }
 
     /// What kind of message a step sends, for signatures.
@@ -140,8 +148,42 @@ impl<'a, 's> HpdTarget<'a, 's> {
     }
 }
 
-/// A fuzz step as a conformance step (judged).
-fn to_hpd(s: &Step) -> HStep {
+/// A fuzz step of another family in an HPD sequence (a cyclic-exchange step).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("step {index} ({text:?}) is a cyclic-exchange step, not an HPD step")]
+pub(crate) struct NotHpdStep {
+    /// Index of the step in the sequence.
+    pub index: usize,
+    /// The step's text.
+    pub text: String,
+}
+
+impl NotHpdStep {
+    fn new(index: usize, s: &Step) -> NotHpdStep {
+        NotHpdStep {
+            index,
+            text: s.text.clone(),
+        }
+    }
+
+    /// The run of a sequence that holds this step: failed before anything was sent.
+    fn failed_run(&self) -> CaseRun {
+        CaseRun {
+            outcome: Outcome::Fail(Failure {
+                step: Some(self.index),
+                message: self.to_string(),
+                expected: "an HPD step".to_owned(),
+                got: "a cyclic-exchange step".to_owned(),
+                requirements: Vec::new(),
+            }),
+            evidence: Vec::new(),
+            elapsed_us: 0,
+        }
+    }
+}
+
+/// A fuzz step as a conformance step (judged); None for a step of another family.
+fn to_hpd(s: &Step) -> Option<HStep> {
     let action = match &s.action {
         Action::Exchange {
             bytes,
@@ -166,16 +208,14 @@ fn to_hpd(s: &Step) -> HStep {
         Action::PowerCycle => HAction::PowerCycle,
         Action::Inputs { value } => HAction::Inputs { value: *value },
         Action::BitRate => HAction::BitRate,
-        // Not an HPD step: replay files are checked on load (`Replay::from_json`) and the
-        // generator makes none, so this never runs; it would only listen for nothing.
-        Action::Cyclic(_) => HAction::Listen { us: 0 },
+        Action::Cyclic(_) => return None,
     };
-    HStep {
+    Some(HStep {
         role: Role::Check,
         action,
         text: s.text.clone(),
         requirements: s.requirements.clone(),
-    }
+    })
 }
 
 impl Target for HpdTarget<'_, '_> {
@@ -241,7 +281,17 @@ impl Target for HpdTarget<'_, '_> {
 
     fn run(&mut self, steps: &[Step]) -> Trial {
         self.clean = false;
-        let mut run = self.run_raw(steps);
+        let (info, case) = match self.case(steps) {
+            Ok(c) => c,
+            // Not a finding of the device: the sequence itself is of another family.
+            Err(e) => {
+                return Trial {
+                    run: e.failed_run(),
+                    fault: None,
+                }
+            }
+        };
+        let mut run = self.session.run_case(&info, &case, false);
         let Outcome::Fail(failure) = run.outcome.clone() else {
             return Trial { run, fault: None };
         };
@@ -307,5 +357,36 @@ impl Target for HpdTarget<'_, '_> {
 
     fn requirement_ids(&self) -> Vec<(String, Level)> {
         engine::requirement_ids(self.family)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fuzz::replay::CyclicStep;
+
+    fn step(action: Action) -> Step {
+        Step {
+            action,
+            class: "test".to_owned(),
+            text: "a step".to_owned(),
+            requirements: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_cyclic_step_is_not_an_hpd_step() {
+        assert!(to_hpd(&step(Action::Listen { us: 5 })).is_some());
+        let cyclic = step(Action::Cyclic(CyclicStep::Hold { cycles: 1 }));
+        assert_eq!(to_hpd(&cyclic), None);
+        let e = NotHpdStep::new(3, &cyclic);
+        assert_eq!(
+            e.to_string(),
+            "step 3 (\"a step\") is a cyclic-exchange step, not an HPD step"
+        );
+        let run = e.failed_run();
+        assert!(
+            matches!(&run.outcome, Outcome::Fail(f) if f.step == Some(3) && f.message == e.to_string())
+        );
     }
 }

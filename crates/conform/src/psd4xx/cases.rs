@@ -4,7 +4,10 @@
 
 use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
+use drivespec_positioner::script::kebab;
+use drivespec_positioner::step::{read_sequence, StateValue, Wait};
 use drivespec_psd4xx::model::{Drive, LinkEvent, RecordRequest};
+use drivespec_psd4xx::step::{Direction, Event, PsdSequence};
 use drivespec_psd4xx::{PkwRequest, PkwRules, RecordWrite, Request, Rules, Width};
 use drivespec_spec::{Access, DeviceModel, Family, FamilyId, Level, Parameter, VectorKind};
 
@@ -799,73 +802,66 @@ impl Gen<'_> {
             {
                 continue;
             }
+            let seq = match read_sequence::<PsdSequence>(v) {
+                Ok(seq) => seq,
+                Err(e) => {
+                    self.errors.push(format!("{}: {e}", v.id));
+                    continue;
+                }
+            };
             let mut steps = Vec::new();
             let mut window = window_default;
-            let Some(body) = v.sequence() else {
-                continue;
-            };
-            if let Some(state) = body.input.get("state").and_then(toml::Value::as_table) {
-                let mut keys: Vec<(&String, &toml::Value)> = state.iter().collect();
-                keys.sort_by_key(|(k, _)| (k.as_str() != "41", k.parse::<u32>().unwrap_or(0)));
-                for (k, value) in keys {
-                    let (Ok(pnu), Some(value)) = (k.parse::<u16>(), value.as_integer()) else {
-                        continue 'vectors; // strings (par 13) and live values need recipes
-                    };
-                    if pnu == 1 || pnu == 2 {
-                        continue 'vectors;
-                    }
-                    if pnu == 44 {
-                        window = value;
-                    }
-                    if pnu == 3 && value == 0 {
-                        continue;
-                    }
-                    self.write_pkw(&mut steps, pnu, value);
-                }
-            }
-            let Some(list) = body.input.get("steps").and_then(toml::Value::as_array) else {
-                continue;
-            };
-            for (n, s) in list.iter().enumerate() {
-                let Some(s) = s.as_table() else {
-                    continue 'vectors;
+            let mut keys: Vec<(&String, &StateValue)> = seq.input.state.iter().collect();
+            keys.sort_by_key(|(k, _)| (k.as_str() != "41", k.parse::<u32>().unwrap_or(0)));
+            for (k, value) in keys {
+                let (Ok(pnu), Some(value)) = (k.parse::<u16>(), value.int()) else {
+                    continue 'vectors; // strings (par 13) and live values need recipes
                 };
-                let int = |k: &str| s.get(k).and_then(toml::Value::as_integer);
+                if pnu == 1 || pnu == 2 {
+                    continue 'vectors;
+                }
+                if pnu == 44 {
+                    window = value;
+                }
+                if pnu == 3 && value == 0 {
+                    continue;
+                }
+                self.write_pkw(&mut steps, pnu, value);
+            }
+            if seq.input.steps.is_empty() {
+                continue;
+            }
+            for (n, s) in seq.input.steps.iter().enumerate() {
                 let mut jam = false;
-                if let Some(e) = s.get("event").and_then(toml::Value::as_str) {
+                if let Some(e) = s.event {
                     let env = match e {
-                        "power-on" => Env::PowerCycle,
-                        "obstruction-detected" => {
+                        Event::PowerOn => Env::PowerCycle,
+                        Event::ObstructionDetected => {
                             jam = true;
                             Env::Jam(true)
                         }
-                        "manual-rotation-at-standstill" => {
-                            let d = int("distance").unwrap_or(0);
-                            Env::Displace(match s.get("direction").and_then(toml::Value::as_str) {
-                                Some("decreasing") => -d,
+                        Event::ManualRotationAtStandstill => {
+                            let d = s.distance.unwrap_or(0);
+                            Env::Displace(match s.direction {
+                                Some(Direction::Decreasing) => -d,
                                 _ => d,
                             })
                         }
-                        "motor-voltage-out-of-range" => Env::MotorVoltage(100),
-                        "motor-voltage-in-range" => Env::MotorVoltage(240),
-                        "position-outside-window-after-run" => Env::MissSteps(window + 1),
-                        "connection-interrupted" => Env::Link(LinkEvent::Lost),
-                        "connection-restored" => Env::Link(LinkEvent::Connected),
-                        "iops-bad" => Env::Link(LinkEvent::IopsBad),
-                        other => {
-                            self.errors.push(format!("{}: unknown event {other}", v.id));
-                            continue 'vectors;
-                        }
+                        Event::MotorVoltageOutOfRange => Env::MotorVoltage(100),
+                        Event::MotorVoltageInRange => Env::MotorVoltage(240),
+                        Event::PositionOutsideWindowAfterRun => Env::MissSteps(window + 1),
+                        Event::ConnectionInterrupted => Env::Link(LinkEvent::Lost),
+                        Event::ConnectionRestored => Env::Link(LinkEvent::Connected),
+                        Event::IopsBad => Env::Link(LinkEvent::IopsBad),
                     };
                     steps.push(step(
                         Role::Check,
-                        format!("step {n}: {e}"),
+                        format!("step {n}: {}", kebab(&e)),
                         Action::Env(env),
                     ));
                 }
-                let control = int("control").and_then(|c| u16::try_from(c).ok());
-                let target = int("target").and_then(|t| i32::try_from(t).ok());
-                if let Some(o) = int("target_offset") {
+                let (control, target) = (s.control, s.target);
+                if let Some(o) = s.target_offset {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: target = actual {o:+}"),
@@ -880,22 +876,22 @@ impl Gen<'_> {
                     };
                     steps.push(step(Role::Check, text, Action::Process { control, target }));
                 }
-                let wait = match s.get("wait").and_then(toml::Value::as_str) {
-                    Some("running") => Action::Until {
+                let wait = match s.wait {
+                    Wait::Running => Action::Until {
                         running: true,
                         max: 1_000,
                     },
-                    Some("standstill") => Action::Until {
+                    Wait::Standstill => Action::Until {
                         running: false,
                         max: 12_000,
                     },
-                    _ => Action::Hold(50),
+                    Wait::Settle => Action::Hold(50),
                 };
-                let wtext = s
-                    .get("wait")
-                    .and_then(toml::Value::as_str)
-                    .unwrap_or("settle");
-                steps.push(step(Role::Check, format!("step {n}: wait {wtext}"), wait));
+                steps.push(step(
+                    Role::Check,
+                    format!("step {n}: wait {}", kebab(&s.wait)),
+                    wait,
+                ));
                 if jam {
                     steps.push(step(
                         Role::Check,

@@ -1,7 +1,10 @@
 //! Case generation for the PSx3xx suite: data-driven from the spec's ISDU table (ranges per
 //! model, access, data types), the ErrorType cases, the guard entries, the ISDU 2 / 193
 //! commands, the three process-data formats, the time-stamp and target-speed tables and the
-//! time-out table, plus hand-written status, time-out and positioning sequences (manual 3–5).
+//! time-out table, the spec's `sequence` vectors ([`sequence`]), plus hand-written status,
+//! time-out and positioning sequences (manual 3–5).
+
+mod sequence;
 
 use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
@@ -2162,6 +2165,7 @@ pub(crate) fn generate<'s>(
     g.status_cases();
     g.timeout_cases();
     g.position_cases();
+    g.sequence_cases();
     if let Some(e) = g.errors.first() {
         return Err(format!("{e} ({} problem(s))", g.errors.len()));
     }

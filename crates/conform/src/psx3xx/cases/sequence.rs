@@ -1,0 +1,293 @@
+//! Cases from the spec's PSx3xx `sequence` vectors (`spec/psx3xx/vectors`): each vector's
+//! start state and steps, read through the family [`Step`] type, become the inputs of one
+//! motion case; the device must show what the reference shows (manual 3.3, 4.4–4.6, 5.9–5.14).
+
+use super::{address, step, Action, Gen, PsxCase, StepDef, MOTION, SETTLE};
+use crate::case::Role;
+use crate::cyclic::Env;
+use drivespec_positioner::script::kebab;
+use drivespec_positioner::step::read_sequence;
+use drivespec_psd4xx::model::LinkEvent;
+use drivespec_psx3xx::isdu::{Request, Value};
+use drivespec_psx3xx::step::{
+    Event, IsduOp, IsduStep, Key, LoopSide, ProcessData, PsxSequence, Step,
+};
+use drivespec_psx3xx::{Output, Stamp, TsCode};
+use drivespec_spec::{Vector, VectorKind};
+
+/// ISDU entries of a start state that a master cannot write: the model code and the
+/// software version are properties of the device (3.1 ISDU 79, 80); a vector that needs
+/// other values than the model's is left to the model tests.
+const FIXED: [&str; 2] = ["79", "80"];
+
+/// The ISDU entry that holds the loop direction (3.1 ISDU 134).
+const LOOP_DIRECTION: &str = "134";
+
+/// ms the model tests of the vectors let pass after every step.
+const STEP_MS: u64 = 8;
+
+impl Gen<'_, '_> {
+    /// One case per `sequence` vector that applies to the model, needs no property the master
+    /// cannot set (another model code or software version, the IO-Link connection as a row
+    /// input) and does not switch the process-data format in its steps.
+    pub(super) fn sequence_cases(&mut self) {
+        let vectors: Vec<&Vector> = self
+            .family
+            .vectors
+            .iter()
+            .filter(|v| v.kind == VectorKind::Sequence)
+            .collect();
+        for v in vectors {
+            if v.model
+                .as_deref()
+                .is_some_and(|m| self.family.model(m).map(|x| &x.id) != Some(&self.model.id))
+            {
+                continue;
+            }
+            let seq = match read_sequence::<PsxSequence>(v) {
+                Ok(seq) => seq,
+                Err(e) => {
+                    self.errors.push(format!("{}: {e}", v.id));
+                    continue;
+                }
+            };
+            if let Some(steps) = self.sequence_steps(&seq) {
+                let reqs = v.requirements.clone();
+                let start = self.idle(self.rules.default_format());
+                self.push(
+                    format!("psx3xx/sequence/{}", v.id),
+                    &reqs,
+                    v.description.clone(),
+                    PsxCase {
+                        start,
+                        steps,
+                        tol: MOTION,
+                        plot: true,
+                    },
+                );
+            }
+        }
+    }
+
+    /// The case steps of a vector, None when it cannot be played through the bus.
+    fn sequence_steps(&mut self, seq: &PsxSequence) -> Option<Vec<StepDef>> {
+        let input = &seq.input;
+        let fixed_differs = FIXED.iter().any(|k| {
+            input
+                .state
+                .get(*k)
+                .is_some_and(|v| v.int() != Some(self.value(k)))
+        });
+        let format_param = self.rules.protocol().format_select.param.clone();
+        let format_index: Option<u16> = format_param.parse().ok();
+        let switches = input.steps.iter().any(|s| {
+            s.isdu
+                .is_some_and(|i| i.op == IsduOp::Write && Some(i.index) == format_index)
+        });
+        if input.steps.is_empty()
+            || fixed_differs
+            || switches
+            || input.steps.iter().any(|s| s.bus.is_some())
+        {
+            return None;
+        }
+        let format = input
+            .state
+            .get(&format_param)
+            .and_then(|v| v.int())
+            .and_then(|f| u8::try_from(f).ok())
+            .or(input.format)
+            .unwrap_or(self.rules.default_format());
+        let mut steps = Vec::new();
+        if format != self.rules.default_format() {
+            steps.extend(self.switch_to(format, Role::Setup));
+        }
+        let mut loop_direction = self.value(LOOP_DIRECTION);
+        for (k, value) in &input.state {
+            if *k == format_param || FIXED.contains(&k.as_str()) {
+                continue;
+            }
+            let value = value.int()?;
+            if k == LOOP_DIRECTION {
+                loop_direction = value;
+            }
+            let write = IsduStep {
+                op: IsduOp::Write,
+                index: k.parse().ok()?,
+                subindex: 0,
+                value: Some(value),
+            };
+            steps.push(self.isdu_step(Role::Setup, "state", &write)?);
+        }
+        for (n, s) in input.steps.iter().enumerate() {
+            let n = n.saturating_add(1);
+            self.sequence_step(&mut steps, n, s, format, loop_direction)?;
+        }
+        steps.push(step(Role::Check, "settle", Action::Hold(SETTLE)));
+        Some(steps)
+    }
+
+    fn sequence_step(
+        &mut self,
+        steps: &mut Vec<StepDef>,
+        n: usize,
+        s: &Step,
+        format: u8,
+        loop_direction: i64,
+    ) -> Option<()> {
+        if let Some(key) = s.key {
+            let (forward, reverse) = match key {
+                Key::Forward => (true, false),
+                Key::Reverse => (false, true),
+                Key::Both => (true, true),
+                Key::None => (false, false),
+            };
+            steps.push(step(
+                Role::Check,
+                format!("step {n}: keys {}", kebab(&key)),
+                Action::Env(Env::Keys { forward, reverse }),
+            ));
+        }
+        if let Some(pd) = &s.pd {
+            steps.push(step(
+                Role::Check,
+                format!("step {n}: process data"),
+                Action::Out(output(format, pd)),
+            ));
+        }
+        if let Some(isdu) = &s.isdu {
+            steps.push(self.isdu_step(Role::Check, &format!("step {n}"), isdu)?);
+        }
+        if let Some(e) = s.event {
+            let text = format!("step {n}: {}", kebab(&e));
+            match e {
+                Event::ObstructionDetected => {
+                    steps.push(step(Role::Check, text, Action::Env(Env::Jam(true))));
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: until standstill"),
+                        Gen::until(false),
+                    ));
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: obstruction removed"),
+                        Action::Env(Env::Jam(false)),
+                    ));
+                }
+                Event::TargetReached | Event::TargetReachedInLoopDirection => {
+                    steps.push(step(Role::Check, text, Gen::until(false)));
+                }
+                Event::ManualRotationAtStandstill => {
+                    let by = s.steps.unwrap_or(1);
+                    let with = if loop_direction == 0 { by } else { -by };
+                    let by = match s.direction {
+                        Some(LoopSide::AgainstLoop) => -with,
+                        _ => with,
+                    };
+                    steps.push(step(Role::Check, text, Action::Env(Env::Displace(by))));
+                }
+                Event::MotorVoltageOutOfRange | Event::MotorVoltageInRange => {
+                    let dv = if e == Event::MotorVoltageInRange {
+                        240
+                    } else {
+                        100
+                    };
+                    steps.push(step(Role::Check, text, Action::Env(Env::MotorVoltage(dv))));
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: 1 s"),
+                        Action::Hold(self.cycles_for(1000)),
+                    ));
+                }
+                Event::ConnectionLost => {
+                    steps.push(step(
+                        Role::Check,
+                        text,
+                        Action::Env(Env::Link(LinkEvent::Lost)),
+                    ));
+                    let ms = s.after_ms.unwrap_or(0).saturating_add(16);
+                    steps.push(step(
+                        Role::Check,
+                        format!("step {n}: {ms} ms"),
+                        Action::Hold(self.cycles_for(ms)),
+                    ));
+                }
+            }
+        }
+        let e = &s.expect;
+        let ms = e.after_us.map_or(0, |us| us / 1000 + 1)
+            + s.hold_ms.or(e.after_ms).unwrap_or(0)
+            + if e.stop == Some(false) { 50 } else { 0 }
+            + if e.torque_param.is_some() { 1000 } else { 0 }
+            + STEP_MS;
+        steps.push(step(
+            Role::Check,
+            format!("step {n}: {ms} ms"),
+            Action::Hold(self.cycles_for(ms)),
+        ));
+        if s.key.is_some_and(|k| k != Key::None) && s.hold_ms.is_some() {
+            steps.push(step(
+                Role::Check,
+                format!("step {n}: keys released"),
+                Action::Env(Env::Keys {
+                    forward: false,
+                    reverse: false,
+                }),
+            ));
+            steps.push(step(
+                Role::Check,
+                format!("step {n}: until standstill"),
+                Gen::until(false),
+            ));
+        }
+        Some(())
+    }
+
+    /// An ISDU read, or a write of an integer encoded per the entry's data type (3.1).
+    fn isdu_step(&self, role: Role, at: &str, isdu: &IsduStep) -> Option<StepDef> {
+        let (index, subindex) = (isdu.index, isdu.subindex);
+        let request = match isdu.op {
+            IsduOp::Read => Request::Read { index, subindex },
+            IsduOp::Write => {
+                let value = isdu.value.unwrap_or(0);
+                let target = self.rules.isdu_target(index, subindex).ok()?;
+                let data = self.rules.encode_value(&target, &Value::Int(value)).ok()?;
+                Request::Write {
+                    index,
+                    subindex,
+                    data,
+                }
+            }
+        };
+        let name = self
+            .family
+            .parameters
+            .iter()
+            .find(|p| address(p) == Some((index, subindex)))
+            .map_or(String::new(), |p| format!(" ({})", p.name));
+        let text = match (isdu.op, isdu.value) {
+            (IsduOp::Write, Some(v)) => format!("{at}: ISDU write {index}.{subindex}{name} = {v}"),
+            _ => format!("{at}: ISDU {} {index}.{subindex}{name}", kebab(&isdu.op)),
+        };
+        Some(step(role, text, Action::Isdu(request)))
+    }
+}
+
+/// A process output of `format` from a step's fields; absent fields are zero (3.3.1).
+fn output(format: u8, pd: &ProcessData) -> Output {
+    match format {
+        0 => Output::TimeStamp {
+            control: TsCode(pd.control.unwrap_or(0)),
+            stamp: Stamp(pd.stamp.unwrap_or(0)),
+        },
+        1 => Output::ControlTarget {
+            control_word: pd.control_word.unwrap_or(0),
+            target: pd.target.unwrap_or(0),
+        },
+        _ => Output::SpeedControlTarget {
+            target_speed: pd.target_speed.unwrap_or(0),
+            control_word: pd.control_word.unwrap_or(0),
+            target: pd.target.unwrap_or(0),
+        },
+    }
+}
