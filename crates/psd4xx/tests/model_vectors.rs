@@ -45,13 +45,15 @@ fn setup(v: &Vector, state: Option<&BTreeMap<String, IntOrText>>) -> Sim {
         // Mapping end before the limits, as 4.7 note 7 orders them.
         let mut keys: Vec<&String> = state.keys().collect();
         keys.sort_by_key(|k| (k.as_str() != "41", k.parse::<u32>().unwrap_or(0)));
-        for k in keys {
+        for k in keys
+            .into_iter()
+            .filter(|k| !matches!(k.as_str(), "3" | "13"))
+        {
             let value = match &state[k] {
                 IntOrText::Int(i) => *i,
                 IntOrText::Text(t) => panic!("{}: par {k} = {t:?} is not a number", v.id),
             };
             match k.as_str() {
-                "3" | "13" => {}
                 "1" => reach_status(&mut s, value),
                 "2" => reach_speed(&mut s, value),
                 _ => s.write(k.parse().unwrap(), value),
