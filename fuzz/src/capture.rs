@@ -75,7 +75,10 @@ pub fn frame(data: &[u8]) {
     if let Ok(f) = RtFrame::parse(data) {
         if let Ok(c) = f.cyclic() {
             assert_eq!(2 + c.data.len() + 4, data.len());
-            assert_eq!(c.c_sdu(c.data.len()).unwrap(), c.data);
+            assert_eq!(
+                c.c_sdu(c.data.len()).expect("a decoded C_SDU re-encodes"),
+                c.data
+            );
             assert!(c.c_sdu(c.data.len() + 1).is_err());
         }
         let _ = (f.dcp(), f.alarm(), f.fragment());

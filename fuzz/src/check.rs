@@ -54,7 +54,7 @@ pub fn hpd(data: &[u8]) {
         max_violations: Some(16),
     };
     let r = HpdChecker::with_catalog(spec(), &options, catalog().clone())
-        .expect("setup")
+        .expect("a checker builds from the built-in spec")
         .run(reader);
     consistent(&r);
 }
@@ -73,7 +73,7 @@ pub fn profinet(data: &[u8]) {
         ..PnOptions::default()
     };
     let r = PnChecker::with_catalog(spec(), pn, catalog().clone())
-        .expect("setup")
+        .expect("a checker builds from the built-in spec")
         .run(Events::new(reader));
     consistent(&r);
 }
@@ -88,7 +88,7 @@ pub fn iolink(data: &[u8]) {
         ..Default::default()
     };
     let r = IoLinkChecker::with_catalog(spec(), options, catalog().clone())
-        .expect("setup")
+        .expect("a checker builds from the built-in spec")
         .run(reader);
     consistent(&r);
 }
@@ -135,7 +135,7 @@ pub fn psd4xx(data: &[u8]) {
         })
     });
     let r = PnChecker::with_catalog(spec(), pn, catalog().clone())
-        .expect("setup")
+        .expect("a checker builds from the built-in spec")
         .run(events);
     consistent(&r);
 }

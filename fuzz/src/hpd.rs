@@ -30,7 +30,12 @@ pub fn frame(data: &[u8]) {
             Ok(Status::Complete(d)) => {
                 assert!(d.len >= 2 && d.len <= data.len());
                 if !cfg!(fuzzing) {
-                    assert_eq!(d.message.to_bytes(rules()).unwrap(), &data[..d.len]);
+                    assert_eq!(
+                        d.message
+                            .to_bytes(rules())
+                            .expect("a decoded frame re-encodes"),
+                        &data[..d.len]
+                    );
                 }
             }
             Ok(Status::Incomplete { need }) => assert!(need >= 1),
@@ -65,7 +70,9 @@ pub fn line(data: &[u8]) {
 pub fn plc(data: &[u8]) {
     let codec = codec();
     if let Ok(program) = codec.decode_program(data) {
-        let bytes = codec.encode_program(&program).unwrap();
+        let bytes = codec
+            .encode_program(&program)
+            .expect("a decoded program re-encodes");
         assert_eq!(&data[..bytes.len()], bytes.as_slice());
         let _ = codec.check(&program);
         let listing = codec.format_program(&program);
@@ -73,7 +80,9 @@ pub fn plc(data: &[u8]) {
             .lines()
             .map(|l| format!("{}\n", l.split_once(": ").map_or(l, |(_, i)| i)))
             .collect();
-        let back = codec.parse_listing(&text).unwrap();
+        let back = codec
+            .parse_listing(&text)
+            .expect("a printed listing parses");
         // The listing drops the bits the manual leaves unused; it is a fixed point.
         assert_eq!(codec.format_program(&back), listing, "listing round trip");
     }
@@ -143,7 +152,7 @@ pub fn roundtrip(data: &[u8]) {
         return;
     };
     let Some(msg) = m.build() else { return };
-    let bytes = msg.to_bytes(rules()).unwrap();
+    let bytes = msg.to_bytes(rules()).expect("a built message encodes");
     assert_eq!(parse(rules(), &bytes), Ok(msg));
 }
 

@@ -3,7 +3,8 @@
 //! The cargo-fuzz targets in `fuzz_targets/` call these; `tests/replay.rs` runs them on every
 //! file under `corpus/<target>/` so plain `cargo test` on stable replays the corpora and the
 //! crashes kept as regression files. Each function panics only when an invariant breaks:
-//! that is the finding.
+//! that is the finding. Every `expect` names its invariant: the built-in spec loads (checked by
+//! `drivespec spec check` in CI), and what a codec or model decoded or built encodes again.
 #![allow(
     clippy::panic,
     clippy::unwrap_used,

@@ -25,10 +25,16 @@ fn psx() -> &'static drivespec_psx3xx::Rules<'static> {
 pub fn psd4xx_image(data: &[u8]) {
     let rules = psd();
     if let Ok(out) = drivespec_psd4xx::Output::parse(rules, data) {
-        assert_eq!(out.to_bytes(rules).unwrap(), data);
+        assert_eq!(
+            out.to_bytes(rules).expect("a decoded value re-encodes"),
+            data
+        );
     }
     if let Ok(input) = drivespec_psd4xx::Input::parse(rules, data) {
-        assert_eq!(input.to_bytes(rules).unwrap(), data);
+        assert_eq!(
+            input.to_bytes(rules).expect("a decoded value re-encodes"),
+            data
+        );
     }
     for direction in [Direction::Out, Direction::In] {
         if let Ok(e) = drivespec_psd4xx::explain(rules, direction, data) {
@@ -41,10 +47,10 @@ pub fn psd4xx_image(data: &[u8]) {
 pub fn psd4xx_pkw(data: &[u8]) {
     let rules = psd().pkw();
     if let Ok(p) = Pkw::<CommandCode>::parse(rules, data) {
-        assert_eq!(p.to_bytes(rules).unwrap(), data);
+        assert_eq!(p.to_bytes(rules).expect("a decoded value re-encodes"), data);
     }
     if let Ok(p) = Pkw::<ResponseCode>::parse(rules, data) {
-        assert_eq!(p.to_bytes(rules).unwrap(), data);
+        assert_eq!(p.to_bytes(rules).expect("a decoded value re-encodes"), data);
     }
 }
 
@@ -56,7 +62,7 @@ pub fn psd4xx_record(data: &[u8]) {
     let index = u16::from_be_bytes(*index) % 128;
     let rules = psd().record();
     if let Ok(w) = RecordWrite::parse(rules, index, body) {
-        assert_eq!(w.to_bytes(rules).unwrap(), body);
+        assert_eq!(w.to_bytes(rules).expect("a decoded value re-encodes"), body);
     }
     if let Ok(r) = RecordRead::parse(rules, index, body) {
         let _ = r.to_bytes(rules);
@@ -76,10 +82,19 @@ pub fn psx3xx_image(data: &[u8]) {
     };
     let format = sel % 4;
     if let Ok(out) = drivespec_psx3xx::Output::parse(rules, format, order, bytes) {
-        assert_eq!(out.to_bytes(rules, order).unwrap(), bytes);
+        assert_eq!(
+            out.to_bytes(rules, order)
+                .expect("a decoded image re-encodes"),
+            bytes
+        );
     }
     if let Ok(input) = drivespec_psx3xx::Input::parse(rules, order, bytes) {
-        assert_eq!(input.to_bytes(rules, order).unwrap(), bytes);
+        assert_eq!(
+            input
+                .to_bytes(rules, order)
+                .expect("a decoded image re-encodes"),
+            bytes
+        );
     }
     if let Ok(e) = drivespec_psx3xx::explain_output(rules, format, order, None, bytes) {
         let _ = e.to_string();

@@ -59,7 +59,9 @@ fn check(d: &Drive, rules: &Rules) {
     let image = d.input_image();
     let input = Input::parse(rules, &image).expect("the drive's input image parses");
     assert_eq!(
-        input.to_bytes(rules).unwrap(),
+        input
+            .to_bytes(rules)
+            .expect("the drive's input image re-encodes"),
         image,
         "input image round trip"
     );
@@ -95,7 +97,9 @@ fn check(d: &Drive, rules: &Rules) {
 pub fn model(data: &[u8]) {
     let mut d = template().clone();
     let rules = d.rules().clone();
-    let mut image = Output::idle(&rules).to_bytes(&rules).unwrap();
+    let mut image = Output::idle(&rules)
+        .to_bytes(&rules)
+        .expect("the idle image encodes");
     let mut now = 0u64;
     let mut rest = data;
     let (mut last_input, mut last_record) = (0, 0);

@@ -102,7 +102,9 @@ fn check(d: &Drive) {
     let image = d.input_image();
     let input = Input::parse(rules, d.byte_order(), &image).expect("the input image parses");
     assert_eq!(
-        input.to_bytes(rules, d.byte_order()).unwrap(),
+        input
+            .to_bytes(rules, d.byte_order())
+            .expect("the drive's input image re-encodes"),
         image,
         "input image round trip"
     );
@@ -177,7 +179,9 @@ pub fn model(data: &[u8]) {
         if image.len() != len {
             image = vec![0; len];
             if let Ok(out) = Output::parse(&rules, d.active_format(), d.byte_order(), &image) {
-                image = out.to_bytes(&rules, d.byte_order()).unwrap();
+                image = out
+                    .to_bytes(&rules, d.byte_order())
+                    .expect("a built output image encodes");
             }
         }
         match op >> 4 {

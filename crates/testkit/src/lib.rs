@@ -2,7 +2,8 @@
 //! `drivespec sim` process that is killed when dropped, and per-process temporary folders.
 //!
 //! The binary's path comes from the test crate (`env!("CARGO_BIN_EXE_drivespec")`). Test
-//! code: a failure to start the binary panics with the reason.
+//! code: a failure to start, feed or wait for the binary panics with the reason, which is how
+//! a test reports it; no input path of the product runs through this crate.
 #![forbid(unsafe_code)]
 #![allow(clippy::expect_used, clippy::unwrap_used, clippy::panic)]
 

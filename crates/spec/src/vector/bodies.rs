@@ -525,10 +525,10 @@ pub struct ProcessImageInput {
     /// The image in hex.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bytes: Option<String>,
-    /// Control word.
+    /// Control word (PSD4xx process image).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<i64>,
-    /// Control word.
+    /// Control word (PSx3xx process image).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control_word: Option<i64>,
     /// `in` (device to master) or `out`.
@@ -554,7 +554,7 @@ pub struct ProcessImageInput {
     /// Status word.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub status: Option<i64>,
-    /// Bit or parameter the request changes (`b99.13`).
+    /// Target position in increments.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target: Option<i64>,
     /// Target speed.
@@ -572,10 +572,10 @@ pub struct ProcessImageExpect {
     /// The image in hex.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bytes: Option<String>,
-    /// Control word.
+    /// Control word (PSD4xx process image).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control: Option<i64>,
-    /// Control word.
+    /// Control word (PSx3xx process image).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub control_word: Option<i64>,
     /// Speed in rpm.
@@ -590,7 +590,7 @@ pub struct ProcessImageExpect {
     /// Status word.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub status: Option<i64>,
-    /// Bit or parameter the request changes (`b99.13`).
+    /// Target position in increments.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target: Option<i64>,
     /// Target speed.
@@ -777,7 +777,7 @@ pub struct PositionInput {
     /// Resolution in µm.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub resolution_um: Option<i64>,
-    /// Bit or parameter the request changes (`b99.13`).
+    /// Target position in increments.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target: Option<i64>,
     /// Up revolutions.
@@ -864,7 +864,7 @@ pub struct PositionExpect {
     /// Steps per revolution.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steps_per_revolution: Option<i64>,
-    /// Bit or parameter the request changes (`b99.13`).
+    /// Target position in increments.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target: Option<i64>,
     /// Travel down.
