@@ -147,16 +147,17 @@ pub(crate) trait CyclicFamily<'s> {
     fn answered(&self, action: &Self::Action, reference: &Self::Input) -> bool;
 }
 
-/// The peer of the device under test `dut`; `sim` is the reference `server` of `model`.
+/// The peer of the device under test `dut`; `sim` is the reference server of `model`, built
+/// by `server` only then.
 pub(crate) fn peer<'p>(
     dut: &Dut,
     model: &str,
-    server: Server<'p>,
+    server: impl FnOnce() -> Server<'p>,
 ) -> Result<Box<dyn Peer + 'p>, SetupError> {
     // Real peers get 2 s per reply (a process may take a while to start).
     const TIMEOUT_US: u64 = 2_000_000;
     Ok(match dut {
-        Dut::Sim { .. } => Box::new(LocalPeer::new(&format!("sim:{model}"), server)),
+        Dut::Sim { .. } => Box::new(LocalPeer::new(&format!("sim:{model}"), server())),
         Dut::Serial { path, baud } => {
             // The cyclic protocol is plain text: 8N1.
             let character = drivespec_spec::hpd::CharacterFormat {

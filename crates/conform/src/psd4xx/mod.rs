@@ -95,7 +95,7 @@ impl<'s> Psd4xxSuite<'s> {
     }
 
     pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
-        crate::cyclic_session::peer(dut, &self.reference.model.id, self.server())
+        crate::cyclic_session::peer(dut, &self.reference.model.id, || self.server())
     }
 }
 

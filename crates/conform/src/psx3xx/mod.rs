@@ -103,7 +103,7 @@ impl<'s> Psx3xxSuite<'s> {
     }
 
     pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer + '_>, SetupError> {
-        crate::cyclic_session::peer(dut, &self.reference.model.id, self.server())
+        crate::cyclic_session::peer(dut, &self.reference.model.id, || self.server())
     }
 }
 

@@ -15,14 +15,6 @@ use drivespec_psx3xx::step::{
 use drivespec_psx3xx::{Output, Stamp, TsCode};
 use drivespec_spec::{Vector, VectorKind};
 
-/// ISDU entries of a start state that a master cannot write: the model code and the
-/// software version are properties of the device (3.1 ISDU 79, 80); a vector that needs
-/// other values than the model's is left to the model tests.
-const FIXED: [&str; 2] = ["79", "80"];
-
-/// The ISDU entry that holds the loop direction (3.1 ISDU 134).
-const LOOP_DIRECTION: &str = "134";
-
 /// ms the model tests of the vectors let pass after every step.
 const STEP_MS: u64 = 8;
 
@@ -72,12 +64,18 @@ impl Gen<'_, '_> {
     /// The case steps of a vector, None when it cannot be played through the bus.
     fn sequence_steps(&mut self, seq: &PsxSequence) -> Option<Vec<StepDef>> {
         let input = &seq.input;
-        let fixed_differs = FIXED.iter().any(|k| {
-            input
-                .state
-                .get(*k)
-                .is_some_and(|v| v.int() != Some(self.value(k)))
-        });
+        // Start-state entries a master cannot write (3.1: e.g. the model code and the software
+        // version) are properties of the device; a vector that needs other values than the
+        // model's is left to the model tests.
+        let fixed = |k: &str| {
+            self.family
+                .parameter(k)
+                .is_some_and(|p| !p.access.writable())
+        };
+        let fixed_differs = input
+            .state
+            .iter()
+            .any(|(k, v)| fixed(k) && v.int() != Some(self.value(k)));
         let format_param = self.rules.protocol().format_select.param.clone();
         let format_index: Option<u16> = format_param.parse().ok();
         let switches = input.steps.iter().any(|s| {
@@ -102,13 +100,14 @@ impl Gen<'_, '_> {
         if format != self.rules.default_format() {
             steps.extend(self.switch_to(format, Role::Setup));
         }
-        let mut loop_direction = self.value(LOOP_DIRECTION);
+        let loop_param = self.rules.protocol().motion.loop_direction_param.clone();
+        let mut loop_direction = self.value(&loop_param);
         for (k, value) in &input.state {
-            if *k == format_param || FIXED.contains(&k.as_str()) {
+            if *k == format_param || fixed(k) {
                 continue;
             }
             let value = value.int()?;
-            if k == LOOP_DIRECTION {
+            if *k == loop_param {
                 loop_direction = value;
             }
             let write = IsduStep {
