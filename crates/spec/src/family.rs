@@ -1,7 +1,8 @@
 //! One manual's part of the spec: its parameters, models, bits, requirements and vectors.
 
 use crate::{
-    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Parameter, Requirement, Resolved, Vector,
+    hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Parameter, Requirement, Resolved,
+    Scenario, Vector,
 };
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -99,6 +100,8 @@ pub struct Family {
     pub errata: Vec<Erratum>,
     /// Golden vectors from the manual's worked examples.
     pub vectors: Vec<Vector>,
+    /// Hand-written cases kept as data.
+    pub scenarios: Vec<Scenario>,
     /// Protocol tables.
     pub protocol: Protocol,
 }

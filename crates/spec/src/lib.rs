@@ -17,6 +17,7 @@ mod model_values;
 mod parameter;
 mod range;
 mod requirement;
+mod scenario;
 mod validate;
 mod vector;
 
@@ -33,6 +34,7 @@ pub use files::SpecFiles;
 pub use parameter::{Access, DataType, EnumValue, ModeMeaning, Parameter, Resolved};
 pub use range::Ranges;
 pub use requirement::{Level, Requirement};
+pub use scenario::{check_scenarios, Scenario, ScenarioError, TypedScenario};
 pub use vector::{
     Body, BodyError, DirectParameterExpect, DirectParameterInput, FormulaExpect, FormulaInput,
     HpdFrameExpect, HpdFrameInput, HpdPlcBytesExpect, HpdPlcBytesInput, HpdPlcExpect, HpdPlcInput,

@@ -3,7 +3,7 @@
 use crate::error::{Problem, ProblemKind};
 use crate::{
     hpd, psd4xx, psx3xx, Bitfield, DeviceModel, Erratum, Family, FamilyId, FamilyInfo, ParamSet,
-    Parameter, Protocol, Requirement, SpecFiles, Vector,
+    Parameter, Protocol, Requirement, Scenario, SpecFiles, Vector,
 };
 use serde::de::DeserializeOwned;
 
@@ -42,6 +42,7 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
     let mut requirements = Vec::new();
     let mut errata = Vec::new();
     let mut vectors = Vec::new();
+    let mut scenarios = Vec::new();
 
     for (path, text) in files.iter().filter(|(p, _)| p.starts_with(&dir)) {
         let Some(mut table) = parse(path, text, problems) else {
@@ -78,6 +79,8 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
             };
         } else if path.starts_with(&format!("{dir}vectors/")) {
             records(path, &mut table, "vector", &mut vectors, problems);
+        } else if path.starts_with(&format!("{dir}scenarios/")) {
+            records(path, &mut table, "scenario", &mut scenarios, problems);
         } else {
             records(path, &mut table, "parameter", &mut parameters, problems);
             records(path, &mut table, "model", &mut models, problems);
@@ -89,6 +92,8 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
         for key in table.keys() {
             let allowed = if path.starts_with(&format!("{dir}vectors/")) {
                 "vector".to_owned()
+            } else if path.starts_with(&format!("{dir}scenarios/")) {
+                "scenario".to_owned()
             } else if path == family_path {
                 "family".to_owned()
             } else if path == protocol_path {
@@ -129,6 +134,7 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
         requirements,
         errata,
         vectors,
+        scenarios,
         protocol: protocol?,
     })
 }
@@ -212,7 +218,8 @@ record!(
     Bitfield,
     Requirement,
     Erratum,
-    Vector
+    Vector,
+    Scenario
 );
 
 /// Deserialises every element of the array `key` (removing it from `table`).

@@ -20,6 +20,7 @@ pub(crate) fn validate(spec: &Spec) -> Vec<Problem> {
         v.requirements();
         v.errata();
         v.vectors();
+        v.scenarios();
     }
     problems
 }
@@ -130,6 +131,16 @@ impl Validator<'_> {
             f.vectors
                 .iter()
                 .map(|v| (v.id.clone(), v.file.as_str(), format!("vector {:?}", v.id))),
+        );
+        self.check_unique(
+            "scenario id",
+            f.scenarios.iter().map(|s| {
+                (
+                    s.id.clone(),
+                    s.file.as_str(),
+                    format!("scenario {:?}", s.id),
+                )
+            }),
         );
     }
 
@@ -441,6 +452,26 @@ impl Validator<'_> {
                 if f.requirement(r).is_none() {
                     self.dangling(&e.file, rec.clone(), "requirement", r);
                 }
+            }
+        }
+    }
+
+    fn scenarios(&mut self) {
+        let f = self.family;
+        for s in &f.scenarios {
+            let rec = format!("scenario {:?}", s.id);
+            if s.requirements.is_empty() {
+                let message = "a scenario names at least one requirement".to_owned();
+                self.push(&s.file, rec.clone(), ProblemKind::Invalid { message });
+            }
+            for r in &s.requirements {
+                if f.requirement(r).is_none() {
+                    self.dangling(&s.file, rec.clone(), "requirement", r);
+                }
+            }
+            if s.steps.is_empty() {
+                let message = "a scenario needs at least one step".to_owned();
+                self.push(&s.file, rec.clone(), ProblemKind::Invalid { message });
             }
         }
     }
