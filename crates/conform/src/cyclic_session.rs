@@ -23,13 +23,22 @@ pub(crate) struct Tolerance {
     pub position: i64,
     /// Speed, rpm.
     pub speed: i64,
+    /// A motion case: judged by the properties of the run ([`CyclicSession::judge_motion`]),
+    /// not cycle by cycle; `position` applies at standstill, `speed` to the speed limit.
+    pub motion: bool,
 }
 
-/// Tolerance of the motion cases: ±3 cycles, ±20 position units, ±2 rpm.
+/// How much faster than the reference's highest speed a device may move in a motion case, %:
+/// the reference runs at the limit in force, a device's speed reading may round differently.
+const SPEED_SLACK_PERCENT: i64 = 5;
+
+/// Tolerance of the motion cases: judged by the properties of the run, positions within 20
+/// units at standstill, speed within the reference's highest plus slack and 2 rpm.
 pub(crate) const MOTION: Tolerance = Tolerance {
-    cycles: 3,
+    cycles: 0,
     position: 20,
     speed: 2,
+    motion: true,
 };
 
 /// One step: who it is for, one line, what it does.
@@ -85,6 +94,13 @@ pub(crate) trait CyclicFamily<'s> {
     const ID: FamilyId;
     /// What every cycle compares exactly, as the evidence says (`status`).
     const EXACT: &'static str;
+    /// The part of the input image besides status, position and speed that is compared
+    /// exactly, as the evidence names it.
+    const CHANNEL: &'static str;
+    /// That part of an input image.
+    type Channel: PartialEq + Clone;
+    /// The channel of an input image.
+    fn channel(input: &Self::Input) -> Self::Channel;
     /// The family's spec.
     fn spec(&self) -> &Family;
     /// The device model.
@@ -186,6 +202,180 @@ pub(crate) struct CyclicSession<'a, F> {
     device: Device<'a>,
 }
 
+/// Whether one side has arrived where an [`Op::Until`] waits: it has shown "Drive is running"
+/// since the step began, or it has stood still (running bit clear, speed 0) with an
+/// unchanged status word for [`Arrival::SETTLE_US`] and at least [`Arrival::MIN_CYCLES`]
+/// cycles. Each side is waited for on its own, so a device that starts later, brakes longer
+/// or confirms the position later than the reference is judged at its own arrival.
+struct Arrival {
+    running: bool,
+    seen: bool,
+    /// The status word the side stands still with, and for how many cycles.
+    still: Option<(u16, u32)>,
+    cycle_us: u64,
+}
+
+impl Arrival {
+    /// How long a standstill lasts before a wait ends, µs: longer than a stop at the
+    /// reversal of a reference loop and than a drive's check of its position before it
+    /// reports the target reached.
+    const SETTLE_US: u64 = 50_000;
+    /// Fewest cycles of standstill that end a wait.
+    const MIN_CYCLES: u32 = 3;
+
+    fn new(running: bool, cycle_us: u64) -> Arrival {
+        Arrival {
+            running,
+            seen: false,
+            still: None,
+            cycle_us,
+        }
+    }
+
+    fn see(&mut self, (_, speed, status): (i64, i64, u16), running_bit: u16) {
+        let on = status & running_bit != 0;
+        self.seen |= on;
+        self.still = match self.still {
+            _ if on || speed != 0 => None,
+            Some((word, n)) if word == status => Some((word, n.saturating_add(1))),
+            _ => Some((status, 1)),
+        };
+    }
+
+    fn done(&self) -> bool {
+        if self.running {
+            return self.seen;
+        }
+        self.still.is_some_and(|(_, n)| {
+            n >= Arrival::MIN_CYCLES
+                && u64::from(n).saturating_mul(self.cycle_us) >= Arrival::SETTLE_US
+        })
+    }
+}
+
+/// The status bit that says a run ended at its target (PSD4xx 3.6, PSx3xx 3.4 bit 0).
+const REACHED: &str = "Target position reached";
+
+/// Cycles at the reference's highest speed that make it the speed in force, which the device
+/// must reach too.
+const CRUISE_CYCLES: usize = 10;
+
+/// A violation found by [`CyclicSession::judge_motion`].
+struct Finding {
+    /// The device's cycle.
+    cycle: usize,
+    /// Its step.
+    step: usize,
+    /// The reference's cycle to show beside it.
+    reference: Option<usize>,
+    /// What differs.
+    what: String,
+}
+
+impl Finding {
+    fn at(cycle: usize, step: usize, reference: Option<usize>, what: String) -> Finding {
+        Finding {
+            cycle,
+            step,
+            reference,
+            what,
+        }
+    }
+}
+
+/// Where the changes of one observed quantity differ between the device and the reference.
+struct Divergence<T> {
+    /// The cycle where it shows.
+    at: usize,
+    /// The reference's cycle of the same change.
+    theirs: Option<usize>,
+    /// Which change (1-based).
+    change: usize,
+    /// The device's value after the change (None: no further change).
+    device: Option<T>,
+    /// The reference's value after the change.
+    reference: Option<T>,
+}
+
+/// The changes of `value` over `segment` (cycles numbered from `from`, `before` the cycle
+/// ahead of it) on the device and on the reference, values for which `skip` holds left out: the first change that differs in
+/// value, or that the device makes in an earlier step than the reference (a reaction may
+/// come later than the reference's, never before its stimulus).
+fn first_difference<I, T: PartialEq + Clone>(
+    before: Option<&Cycle<I>>,
+    segment: &[Cycle<I>],
+    from: usize,
+    value: impl Fn(&I) -> T,
+    skip: impl Fn(&T) -> bool,
+    lead: Option<T>,
+) -> Option<Divergence<T>> {
+    let changes = |start: Option<T>, side: &mut dyn Iterator<Item = (usize, usize, &I)>| {
+        let mut out: Vec<(usize, usize, T)> = Vec::new();
+        if let Some(v) = start.filter(|v| !skip(v)) {
+            out.push((from, 0, v));
+        }
+        for (i, step, x) in side {
+            let v = value(x);
+            if !skip(&v) && out.last().is_none_or(|(_, _, last)| *last != v) {
+                out.push((from + i, step, v));
+            }
+        }
+        out
+    };
+    // Both sides start from what they showed before the segment; the first segment starts
+    // from what the device showed first (the state both had before the first stimulus).
+    let first = segment
+        .first()
+        .and_then(|c| c.dut.as_ref().ok())
+        .map(&value);
+    let (d_start, r_start) = match before {
+        Some(c) => (c.dut.as_ref().ok().map(&value), Some(value(&c.reference))),
+        None => (first.clone(), first),
+    };
+    let d = changes(
+        d_start,
+        &mut segment
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| c.dut.as_ref().ok().map(|d| (i, c.step, d))),
+    );
+    let r = changes(
+        r_start,
+        &mut segment
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (i, c.step, &c.reference)),
+    );
+    let k = (0..d.len().max(r.len())).find(|&k| match (d.get(k), r.get(k)) {
+        (Some(x), Some(y)) => x.2 != y.2 || (lead.as_ref() == Some(&x.2) && x.1 < y.1),
+        (None, None) => false,
+        _ => true,
+    })?;
+    // Where the divergence shows: the later of the two changes (a missing change shows at
+    // the other side's), or the device's change made too early.
+    let at = match (d.get(k), r.get(k)) {
+        (Some(x), Some(y)) if x.2 == y.2 => x.0,
+        (Some(x), Some(y)) => x.0.max(y.0),
+        (Some(x), None) => x.0,
+        (None, Some(y)) => y.0,
+        (None, None) => from,
+    };
+    Some(Divergence {
+        at,
+        theirs: r.get(k).map(|x| x.0),
+        change: k + 1,
+        device: d.get(k).map(|x| x.2.clone()),
+        reference: r.get(k).map(|x| x.2.clone()),
+    })
+}
+
+/// " in step N" for a cycle, empty for none.
+fn step_of<I>(cycles: &[Cycle<I>], at: Option<usize>) -> String {
+    at.and_then(|i| cycles.get(i))
+        .map(|c| format!(" in step {}", c.step))
+        .unwrap_or_default()
+}
+
 /// One cycle as both sides saw it.
 struct Cycle<I> {
     step: usize,
@@ -206,6 +396,8 @@ struct Run<'r, 's, I, O> {
     evidence: Vec<Record>,
     failure: Option<Failure>,
     reqs: &'r [String],
+    /// The cycle counts at which [`Op::Until`] waits ended: both sides had arrived.
+    arrivals: Vec<usize>,
 }
 
 impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
@@ -364,22 +556,23 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     }
                 }
                 Op::Until { running, max } => {
-                    let running_bit = self.family.running_bit();
-                    for i in 0..max {
+                    let bit = self.family.running_bit();
+                    let cycle_us = self.family.cycle_us();
+                    let mut reference = Arrival::new(running, cycle_us);
+                    let mut device = Arrival::new(running, cycle_us);
+                    for _ in 0..max {
                         self.cycle(run, n)?;
-                        let done = run.cycles.last().is_some_and(|c| {
-                            let (_, speed, status) = F::motion(&c.reference);
-                            let on = status & running_bit != 0;
-                            if running {
-                                on
-                            } else {
-                                i >= 2 && !on && speed == 0
+                        if let Some(c) = run.cycles.last() {
+                            reference.see(F::motion(&c.reference), bit);
+                            if let Ok(d) = &c.dut {
+                                device.see(F::motion(d), bit);
                             }
-                        });
-                        if done {
+                        }
+                        if reference.done() && device.done() {
                             break;
                         }
                     }
+                    run.arrivals.push(run.cycles.len());
                 }
                 Op::Advance(us) => {
                     run.t = run.t.saturating_add(us);
@@ -446,6 +639,43 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
 
     /// Judges the cycles under `tol`; marks the records and sets the first failure.
     fn judge(&self, run: &mut Run<'_, 's, F::Input, F::Output>, tol: Tolerance) {
+        let bad_steps = if tol.motion {
+            self.judge_motion(run, tol)
+        } else {
+            self.judge_cycles(run, tol)
+        };
+        let note = if !tol.motion {
+            format!(
+                "every cycle: {} exact; position ±{}, speed ±{}, time ±{} cycle(s)",
+                F::EXACT,
+                tol.position,
+                tol.speed,
+                tol.cycles
+            )
+        } else {
+            format!(
+                "motion: between waits, each status bit and the direction change as the reference's, never in an earlier step; speed within ±{} % of the reference's highest; where both have settled, {} exact and position ±{}",
+                SPEED_SLACK_PERCENT,
+                F::EXACT,
+                tol.position
+            )
+        };
+        for r in &mut run.evidence {
+            if r.ok.is_none() && r.role != Role::Cleanup {
+                r.ok = Some(!bad_steps.contains(&r.step));
+                r.note = Some(note.clone());
+            }
+        }
+    }
+
+    /// Every cycle of the device matches a reference cycle at most `tol.cycles` earlier or
+    /// later (exact parts equal, position and speed within the tolerance); the steps with a
+    /// cycle that does not.
+    fn judge_cycles(
+        &self,
+        run: &mut Run<'_, 's, F::Input, F::Output>,
+        tol: Tolerance,
+    ) -> Vec<usize> {
         let k = usize::try_from(tol.cycles).unwrap_or(0);
         let fits = |d: &F::Input, r: &F::Input| {
             let ((da, ds, _), (ra, rs, _)) = (F::motion(d), F::motion(r));
@@ -470,38 +700,235 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 bad_steps.push(c.step);
             }
             if run.failure.is_none() {
-                let got = match &c.dut {
-                    Ok(d) => self.family.describe(d),
-                    Err(e) => e.clone(),
-                };
-                run.failure = Some(Failure {
-                    step: Some(c.step),
-                    message: format!(
-                        "cycle {} at {} ms (step {}): the input image differs from the reference (tolerance ±{} cycle(s), position ±{}, speed ±{})",
-                        i + 1,
-                        c.t / 1000,
-                        c.step,
-                        tol.cycles,
-                        tol.position,
-                        tol.speed
-                    ),
-                    expected: self.family.describe(&c.reference),
-                    got,
-                    requirements: self.refs(&self.family.cited(run.reqs, c.dut.as_ref().ok(), &c.reference)),
-                });
+                let what = format!(
+                    "the input image differs from the reference (tolerance ±{} cycle(s), position ±{}, speed ±{})",
+                    tol.cycles, tol.position, tol.speed
+                );
+                run.failure = Some(self.cycle_failure(run.reqs, i, c, &c.reference, what));
             }
         }
-        for r in &mut run.evidence {
-            if r.ok.is_none() && r.role != Role::Cleanup {
-                r.ok = Some(!bad_steps.contains(&r.step));
-                r.note = Some(format!(
-                    "every cycle: {} exact; position ±{}, speed ±{}, time ±{} cycle(s)",
-                    F::EXACT,
-                    tol.position,
-                    tol.speed,
-                    tol.cycles
+        bad_steps
+    }
+
+    /// A motion case is judged by what the manuals fix about a run, not by its timing.
+    /// Between two arrivals of [`Op::Until`] (where both sides are waited for), every status
+    /// bit goes through the same changes as the reference's (the order of status events) and
+    /// the direction of travel changes as the reference's (approach and reference loop); the
+    /// speed stays within the reference's highest (the limits in force) and reaches it where
+    /// the reference cruises at it; wherever both have settled, the exact parts agree and the
+    /// positions are within `tol.position`. The steps with a violation.
+    fn judge_motion(
+        &self,
+        run: &mut Run<'_, 's, F::Input, F::Output>,
+        tol: Tolerance,
+    ) -> Vec<usize> {
+        let mut bad: Vec<Finding> = Vec::new();
+        if let Some((i, c)) = run.cycles.iter().enumerate().find(|(_, c)| c.dut.is_err()) {
+            bad.push(Finding::at(i, c.step, None, "no input image".to_owned()));
+        }
+        let running = self.family.running_bit();
+        let mut bounds = vec![0];
+        bounds.extend(run.arrivals.iter().copied());
+        bounds.push(run.cycles.len());
+        for w in bounds.windows(2) {
+            let (from, to) = match w {
+                [a, b] if a < b => (*a, *b),
+                _ => continue,
+            };
+            let segment = run.cycles.get(from..to).unwrap_or(&[]);
+            let before = from.checked_sub(1).and_then(|i| run.cycles.get(i));
+            for bit in 0..16u16 {
+                let mask = 1u16 << bit;
+                let what = |v: Option<bool>| match v {
+                    Some(true) => "set",
+                    Some(false) => "clear",
+                    None => "no further change",
+                };
+                if let Some(x) = first_difference(
+                    before,
+                    segment,
+                    from,
+                    |i| F::motion(i).2 & mask != 0,
+                    |_| false,
+                    (mask == running).then_some(true),
+                ) {
+                    bad.push(Finding::at(
+                        x.at,
+                        run.cycles.get(x.at).map_or(0, |c| c.step),
+                        x.theirs,
+                        format!(
+                            "status bit {bit}: change {} makes it {} on the device{}, {} on the reference{}",
+                            x.change,
+                            what(x.device),
+                            step_of(&run.cycles, Some(x.at)),
+                            what(x.reference),
+                            step_of(&run.cycles, x.theirs)
+                        ),
+                    ));
+                }
+            }
+            let word = |v: Option<i64>| match v {
+                Some(1) => "increasing",
+                Some(_) => "decreasing",
+                None => "no further movement",
+            };
+            if let Some(x) = first_difference(
+                before,
+                segment,
+                from,
+                |i| F::motion(i).1.signum(),
+                |v| *v == 0,
+                None,
+            ) {
+                bad.push(Finding::at(
+                    x.at,
+                    run.cycles.get(x.at).map_or(0, |c| c.step),
+                    x.theirs,
+                    format!(
+                        "movement {}: {} on the device{}, {} on the reference{}",
+                        x.change,
+                        word(x.device),
+                        step_of(&run.cycles, Some(x.at)),
+                        word(x.reference),
+                        step_of(&run.cycles, x.theirs)
+                    ),
                 ));
             }
+            if let Some(x) = first_difference(before, segment, from, F::channel, |_| false, None) {
+                bad.push(Finding::at(
+                    x.at,
+                    run.cycles.get(x.at).map_or(0, |c| c.step),
+                    x.theirs,
+                    format!(
+                        "{}: change {} differs from the reference's{}",
+                        F::CHANNEL,
+                        x.change,
+                        step_of(&run.cycles, Some(x.at))
+                    ),
+                ));
+            }
+        }
+        // The speed: never above the reference's highest, and as high where it cruises.
+        let speeds: Vec<i64> = run
+            .cycles
+            .iter()
+            .map(|c| F::motion(&c.reference).1.abs())
+            .collect();
+        let top = speeds.iter().copied().max().unwrap_or(0);
+        let limit = top
+            .saturating_mul(100 + SPEED_SLACK_PERCENT)
+            .saturating_div(100)
+            .saturating_add(tol.speed);
+        let device_top = run
+            .cycles
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| c.dut.as_ref().ok().map(|d| (i, F::motion(d).1.abs())))
+            .max_by_key(|(_, v)| *v);
+        if let Some((i, v)) = device_top.filter(|(_, v)| *v > limit) {
+            bad.push(Finding::at(
+                i,
+                run.cycles.get(i).map_or(0, |c| c.step),
+                None,
+                format!("speed {v} rpm is above the highest allowed, {limit} rpm"),
+            ));
+        }
+        let cruise = speeds.iter().filter(|v| **v == top).count();
+        let floor = top
+            .saturating_mul(100 - SPEED_SLACK_PERCENT)
+            .saturating_div(100)
+            .saturating_sub(tol.speed);
+        if top > 0 && cruise >= CRUISE_CYCLES && device_top.is_none_or(|(_, v)| v < floor) {
+            let (i, v) = device_top.unwrap_or((0, 0));
+            bad.push(Finding::at(
+                i,
+                run.cycles.get(i).map_or(0, |c| c.step),
+                None,
+                format!("the highest speed is {v} rpm; the speed in force is {top} rpm (at least {floor} rpm)"),
+            ));
+        }
+        // Settled on both sides: exact parts equal, positions within the tolerance.
+        let cycle_us = self.family.cycle_us();
+        let bit = self.family.running_bit();
+        let reached = self
+            .family
+            .spec()
+            .bitfield("status")
+            .and_then(|b| b.bits.iter().find(|x| x.name == REACHED))
+            .and_then(|x| 1u16.checked_shl(x.bit))
+            .unwrap_or(0);
+        let (mut dev, mut refr) = (Arrival::new(false, cycle_us), Arrival::new(false, cycle_us));
+        for (i, c) in run.cycles.iter().enumerate() {
+            refr.see(F::motion(&c.reference), bit);
+            let Ok(d) = &c.dut else {
+                dev = Arrival::new(false, cycle_us);
+                continue;
+            };
+            dev.see(F::motion(d), bit);
+            if !(dev.done() && refr.done()) {
+                continue;
+            }
+            // Positions agree where the reference has reached its target; where a run ended
+            // otherwise (an obstruction, a lost connection), where it stops depends on timing.
+            let (dp, rp) = (F::motion(d).0, F::motion(&c.reference).0);
+            let at_target = F::motion(&c.reference).2 & reached != 0;
+            if !F::exact_equal(d, &c.reference) || (at_target && (dp - rp).abs() > tol.position) {
+                bad.push(Finding::at(
+                    i,
+                    c.step,
+                    Some(i),
+                    format!(
+                        "both settled: {} differs, or the positions at the target are more than {} apart",
+                        F::EXACT,
+                        tol.position
+                    ),
+                ));
+                break;
+            }
+        }
+        bad.sort_by_key(|b| b.cycle);
+        let mut bad_steps: Vec<usize> = bad.iter().map(|b| b.step).collect();
+        bad_steps.sort_unstable();
+        bad_steps.dedup();
+        if run.failure.is_none() {
+            if let Some(f) = bad.first() {
+                if let Some(c) = run.cycles.get(f.cycle) {
+                    let reference = f
+                        .reference
+                        .and_then(|t| run.cycles.get(t))
+                        .map_or(&c.reference, |r| &r.reference);
+                    run.failure =
+                        Some(self.cycle_failure(run.reqs, f.cycle, c, reference, f.what.clone()));
+                }
+            }
+        }
+        bad_steps
+    }
+
+    /// The failure of cycle `i` against `reference`, saying `what`.
+    fn cycle_failure(
+        &self,
+        reqs: &[String],
+        i: usize,
+        c: &Cycle<F::Input>,
+        reference: &F::Input,
+        what: String,
+    ) -> Failure {
+        let got = match &c.dut {
+            Ok(d) => self.family.describe(d),
+            Err(e) => e.clone(),
+        };
+        Failure {
+            step: Some(c.step),
+            message: format!(
+                "cycle {} at {} ms (step {}): {what}",
+                i + 1,
+                c.t / 1000,
+                c.step
+            ),
+            expected: self.family.describe(reference),
+            got,
+            requirements: self.refs(&self.family.cited(reqs, c.dut.as_ref().ok(), reference)),
         }
     }
 
@@ -520,6 +947,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             evidence: Vec::new(),
             failure: None,
             reqs: &info.requirements,
+            arrivals: Vec::new(),
         };
         let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),

@@ -61,6 +61,7 @@ pub(crate) const EXCHANGE: Tolerance = Tolerance {
     cycles: 1,
     position: 0,
     speed: 0,
+    motion: false,
 };
 
 /// A generated case.

@@ -33,6 +33,12 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
     type Case = PsdCase;
     const ID: FamilyId = FamilyId::Psd4xx;
     const EXACT: &'static str = "PKW and status";
+    const CHANNEL: &'static str = "PKW response";
+    type Channel = drivespec_psd4xx::PkwResponse;
+
+    fn channel(i: &Input) -> drivespec_psd4xx::PkwResponse {
+        i.pkw
+    }
 
     fn spec(&self) -> &Family {
         self.suite.family()

@@ -74,6 +74,7 @@ pub(crate) const EXACT: Tolerance = Tolerance {
     cycles: 0,
     position: 0,
     speed: 0,
+    motion: false,
 };
 
 /// A generated case.

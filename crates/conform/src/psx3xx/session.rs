@@ -159,6 +159,10 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
     type Case = PsxCase;
     const ID: FamilyId = FamilyId::Psx3xx;
     const EXACT: &'static str = "status";
+    const CHANNEL: &'static str = "nothing else";
+    type Channel = ();
+
+    fn channel(_: &Input) {}
 
     fn spec(&self) -> &Family {
         self.suite.family()

@@ -12,5 +12,6 @@
 
 pub mod mutants;
 pub mod psd4xx_mutants;
+pub mod psd4xx_variants;
 pub mod psx3xx_mutants;
 pub mod reference_server;

@@ -1,0 +1,125 @@
+//! PSD4xx legal variants: the reference drive changed only where the manual leaves the
+//! choice to the implementation (4.3 fixes maxima of acceleration and deceleration, not a
+//! profile; chapter 3 fixes no reaction time), as a second team's drive would behave.
+
+use super::mutants::spec;
+use drivespec_conform::cyclic::{CyclicDevice, Env};
+use drivespec_positioner::Micros;
+use drivespec_psd4xx::model::{Drive, DriveConfig, RecordAnswer, RecordFailure, RecordRequest};
+use drivespec_psd4xx::{Input, Output};
+use drivespec_spec::FamilyId;
+use std::collections::VecDeque;
+
+/// A freedom the manual leaves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A new control word or target takes effect this many µs later.
+    StartLatency(Micros),
+    /// Status bit 0 is reported this many µs after the drive has arrived (an encoder check).
+    ReachedLater(Micros),
+}
+
+/// The reference PSD 401 with the freedom `kind` taken.
+#[derive(Clone)]
+pub struct Variant {
+    kind: Kind,
+    drive: Drive,
+    /// Control word and target in force, and the changes still to take effect (due, control,
+    /// target).
+    applied: (u16, i32),
+    pending: VecDeque<(Micros, u16, i32)>,
+    last_seen: (u16, i32),
+    /// Since when bit 0 has been set by the drive.
+    reached_since: Option<Micros>,
+}
+
+impl Variant {
+    /// The variant `kind`.
+    pub fn new(kind: Kind) -> Variant {
+        let drive = Drive::new(spec(), DriveConfig::new("PSD401-5V")).unwrap();
+        Variant {
+            kind,
+            drive,
+            applied: (0, 0),
+            pending: VecDeque::new(),
+            last_seen: (0, 0),
+            reached_since: None,
+        }
+    }
+}
+
+fn reached_bit() -> u16 {
+    let b = spec().family(FamilyId::Psd4xx).bitfield("status").unwrap();
+    1 << b
+        .bits
+        .iter()
+        .find(|x| x.name == "Target position reached")
+        .unwrap()
+        .bit
+}
+
+impl CyclicDevice<'static> for Variant {
+    fn cycle(&mut self, now: Micros, image: &[u8]) -> Result<Vec<u8>, String> {
+        let rules = self.drive.rules().clone();
+        let mut out = Output::parse(&rules, image).map_err(|e| e.to_string())?;
+        if let Kind::StartLatency(us) = self.kind {
+            let seen = (out.control, out.target);
+            if seen != self.last_seen {
+                self.pending
+                    .push_back((now.saturating_add(us), seen.0, seen.1));
+                self.last_seen = seen;
+            }
+            while self.pending.front().is_some_and(|p| p.0 <= now) {
+                if let Some((_, c, t)) = self.pending.pop_front() {
+                    self.applied = (c, t);
+                }
+            }
+            (out.control, out.target) = self.applied;
+        }
+        let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
+        let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
+        if let Kind::ReachedLater(us) = self.kind {
+            let bit = reached_bit();
+            if input.status & bit != 0 {
+                let since = *self.reached_since.get_or_insert(now);
+                if now.saturating_sub(since) < us {
+                    input.status &= !bit;
+                }
+            } else {
+                self.reached_since = None;
+            }
+        }
+        Ok(input.to_bytes(&rules).unwrap())
+    }
+
+    fn advance(&mut self, now: Micros) {
+        CyclicDevice::advance(&mut self.drive, now);
+    }
+
+    fn record(
+        &mut self,
+        now: Micros,
+        req: RecordRequest,
+    ) -> Option<Result<RecordAnswer, RecordFailure>> {
+        self.drive.record(now, req)
+    }
+
+    fn env(&mut self, now: Micros, env: Env) -> bool {
+        self.drive.env(now, env)
+    }
+
+    fn clone_box(&self) -> Box<dyn CyclicDevice<'static>> {
+        Box::new(self.clone())
+    }
+}
+
+/// Every PSD4xx legal variant with its name.
+pub fn variants() -> Vec<(&'static str, Kind)> {
+    vec![
+        ("start latency 1 ms", Kind::StartLatency(1_000)),
+        ("start latency 3 ms", Kind::StartLatency(3_000)),
+        ("start latency 10 ms", Kind::StartLatency(10_000)),
+        ("start latency 30 ms", Kind::StartLatency(30_000)),
+        ("bit 0 10 ms after arrival", Kind::ReachedLater(10_000)),
+    ]
+}
