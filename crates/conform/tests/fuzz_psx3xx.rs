@@ -212,7 +212,12 @@ fn replay_files_replay_byte_for_byte() {
         &mut std::io::sink(),
     )
     .unwrap();
-    let f = s.findings.first().expect("a finding");
+    // A finding reproduced from a fresh device replays on a fresh one.
+    let f = s
+        .findings
+        .iter()
+        .find(|f| f.replay.finding.as_ref().is_some_and(|i| i.reproduced))
+        .expect("a reproduced finding");
     let file = f.file.clone().unwrap();
     let text = std::fs::read_to_string(&file).unwrap();
     // The same seed finds the same findings with byte-identical replay files.
