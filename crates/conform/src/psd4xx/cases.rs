@@ -21,7 +21,7 @@ pub(crate) enum Action {
         /// Target value.
         target: Option<i32>,
     },
-    /// A PKW block; cycles until the reference answers it (at most [`PKW_MAX_CYCLES`]).
+    /// A PKW block; cycles until the reference and the device answer it.
     Pkw(PkwRequest),
     /// New control word (absent: unchanged) and a target relative to the reference's actual
     /// position, then one cycle.
@@ -48,7 +48,8 @@ pub(crate) enum Action {
     Advance(u64),
 }
 
-/// Most cycles a PKW command is repeated before the case moves on (PSD-PKW-002).
+/// Cycles a PKW command is repeated beyond the longest save before the case moves on
+/// (PSD-PKW-002).
 pub(crate) const PKW_MAX_CYCLES: u32 = 8;
 
 /// One step of a case.

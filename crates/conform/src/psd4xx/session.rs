@@ -8,7 +8,7 @@ use crate::cyclic::{Reply, Request, Server};
 use crate::cyclic_session::{CyclicFamily, CyclicSession, Op, Tolerance};
 use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, Output, PkwRequest};
-use drivespec_spec::{Family, FamilyId};
+use drivespec_spec::{Family, FamilyId, Protocol};
 
 /// A session on one device under test.
 pub(crate) type Psd4xxSession<'a, 's> = CyclicSession<'a, Psd4xx<'a, 's>>;
@@ -23,6 +23,17 @@ impl<'a, 's> Psd4xx<'a, 's> {
     /// The family of `suite`.
     pub(crate) fn new(suite: &'a Psd4xxSuite<'s>) -> Psd4xx<'a, 's> {
         Psd4xx { suite }
+    }
+
+    /// Most cycles a PKW command is repeated: the longest save (4.7, spec
+    /// `positioning.save.max_ms`) plus [`PKW_MAX_CYCLES`].
+    fn pkw_cycles(&self) -> u32 {
+        let save_ms = match &self.suite.family().protocol {
+            Protocol::Psd4xx(p) => u64::from(p.positioning.save.max_ms),
+            _ => 0,
+        };
+        let save = save_ms.saturating_mul(1000).div_ceil(CYCLE_US);
+        PKW_MAX_CYCLES.saturating_add(u32::try_from(save).unwrap_or(u32::MAX))
     }
 }
 
@@ -207,7 +218,7 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
                 next.pkw = *req;
                 Op::Send {
                     out: next,
-                    max: PKW_MAX_CYCLES,
+                    max: self.pkw_cycles(),
                 }
             }
             Action::Hold(k) => Op::Hold(*k),

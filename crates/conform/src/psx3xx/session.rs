@@ -159,7 +159,7 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
     type Case = PsxCase;
     const ID: FamilyId = FamilyId::Psx3xx;
     const EXACT: &'static str = "status";
-    const CHANNEL: &'static str = "nothing else";
+    const CHANNEL: &'static str = "";
     type Channel = ();
 
     fn channel(_: &Input) {}

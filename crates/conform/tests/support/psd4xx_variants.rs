@@ -6,7 +6,7 @@ use super::mutants::spec;
 use drivespec_conform::cyclic::{CyclicDevice, Env};
 use drivespec_positioner::Micros;
 use drivespec_psd4xx::model::{Drive, DriveConfig, RecordAnswer, RecordFailure, RecordRequest};
-use drivespec_psd4xx::{Input, Output};
+use drivespec_psd4xx::{Input, Output, PkwResponse, Request, Width};
 use drivespec_spec::FamilyId;
 use std::collections::VecDeque;
 
@@ -17,6 +17,9 @@ pub enum Kind {
     StartLatency(Micros),
     /// Status bit 0 is reported this many µs after the drive has arrived (an encoder check).
     ReachedLater(Micros),
+    /// A save (par 96 = 1) is answered this many µs after the command came (4.7: "can take up
+    /// to 1 second"); meanwhile the drive answers "no response".
+    SlowSave(Micros),
 }
 
 /// The reference PSD 401 with the freedom `kind` taken.
@@ -31,6 +34,8 @@ pub struct Variant {
     last_seen: (u16, i32),
     /// Since when bit 0 has been set by the drive.
     reached_since: Option<Micros>,
+    /// Since when the save command in force came.
+    saving_since: Option<Micros>,
 }
 
 impl Variant {
@@ -44,6 +49,7 @@ impl Variant {
             pending: VecDeque::new(),
             last_seen: (0, 0),
             reached_since: None,
+            saving_since: None,
         }
     }
 }
@@ -78,6 +84,25 @@ impl CyclicDevice<'static> for Variant {
         }
         let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
         let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
+        if let Kind::SlowSave(us) = self.kind {
+            let save = rules
+                .pkw()
+                .encode_request(&Request::Write {
+                    pnu: 96,
+                    index: None,
+                    width: Width::Word,
+                    value: 1,
+                })
+                .unwrap();
+            if out.pkw == save {
+                let since = *self.saving_since.get_or_insert(now);
+                if now.saturating_sub(since) < us {
+                    input.pkw = PkwResponse::default();
+                }
+            } else {
+                self.saving_since = None;
+            }
+        }
         if let Kind::ReachedLater(us) = self.kind {
             let bit = reached_bit();
             if input.status & bit != 0 {
@@ -121,5 +146,6 @@ pub fn variants() -> Vec<(&'static str, Kind)> {
         ("start latency 10 ms", Kind::StartLatency(10_000)),
         ("start latency 30 ms", Kind::StartLatency(30_000)),
         ("bit 0 10 ms after arrival", Kind::ReachedLater(10_000)),
+        ("save answered after 900 ms", Kind::SlowSave(900_000)),
     ]
 }
