@@ -28,6 +28,17 @@ pub(crate) struct Tolerance {
     pub motion: bool,
 }
 
+/// Whether both replies carry data of the same length: how a read of a device's own value
+/// (spec `per_device`: serial number, version, a measurement) is judged.
+pub(crate) fn same_length(expected: &Reply, got: &Reply) -> Option<String> {
+    match (expected, got) {
+        (Reply::Data(e), Reply::Data(g)) if e.len() == g.len() => {
+            Some("the device's own value (the manual gives an example): type and length".to_owned())
+        }
+        _ => None,
+    }
+}
+
 /// How much faster than the reference's highest speed a device may move in a motion case, %:
 /// the reference runs at the limit in force, a device's speed reading may round differently.
 const SPEED_SLACK_PERCENT: i64 = 5;
@@ -131,8 +142,9 @@ pub(crate) trait CyclicFamily<'s> {
     fn describe_output(&self, out: &Self::Output) -> String;
     /// Actual position, speed and status word of an input image.
     fn motion(input: &Self::Input) -> (i64, i64, u16);
-    /// Whether the parts compared exactly are equal.
-    fn exact_equal(device: &Self::Input, reference: &Self::Input) -> bool;
+    /// Whether the parts compared exactly are equal (a device's own values, spec
+    /// `per_device`, by type and length only).
+    fn exact_equal(&self, device: &Self::Input, reference: &Self::Input) -> bool;
     /// The "Drive is running" status bit.
     fn running_bit(&self) -> u16;
     /// The requirements a differing cycle cites: the case's plus those of what differs.
@@ -690,7 +702,9 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         let k = usize::try_from(tol.cycles).unwrap_or(0);
         let fits = |d: &F::Input, r: &F::Input| {
             let ((da, ds, _), (ra, rs, _)) = (F::motion(d), F::motion(r));
-            F::exact_equal(d, r) && (da - ra).abs() <= tol.position && (ds - rs).abs() <= tol.speed
+            self.family.exact_equal(d, r)
+                && (da - ra).abs() <= tol.position
+                && (ds - rs).abs() <= tol.speed
         };
         let n = run.cycles.len();
         let mut bad_steps = Vec::new();

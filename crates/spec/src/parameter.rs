@@ -222,6 +222,10 @@ pub struct Parameter {
     /// The value changes by itself.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub live: bool,
+    /// The value is the device's own (identity, measurement): the manual gives an example or
+    /// nothing, so a conforming device may report any value of the type, length and range.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub per_device: bool,
     /// Manual section.
     pub source: String,
     /// One line.

@@ -5,7 +5,7 @@ use super::cases::{status_bit, Action, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::CaseInfo;
 use crate::cyclic::{Reply, Request, Server};
-use crate::cyclic_session::{CyclicFamily, CyclicSession, Op, Tolerance};
+use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
 use drivespec_psd4xx::model::RecordRequest;
 use drivespec_psd4xx::{Input, Output, PkwRequest};
 use drivespec_spec::{Family, FamilyId, Protocol};
@@ -23,6 +23,15 @@ impl<'a, 's> Psd4xx<'a, 's> {
     /// The family of `suite`.
     pub(crate) fn new(suite: &'a Psd4xxSuite<'s>) -> Psd4xx<'a, 's> {
         Psd4xx { suite }
+    }
+
+    /// Whether parameter `number` is the device's own value (spec `per_device`).
+    fn per_device(&self, number: u16) -> bool {
+        self.suite
+            .family()
+            .parameters
+            .iter()
+            .any(|p| p.per_device && p.number == u32::from(number))
     }
 
     /// Most cycles a PKW command is repeated: the longest save (4.7, spec
@@ -133,8 +142,24 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         (i64::from(i.actual), i64::from(i.speed), i.status)
     }
 
-    fn exact_equal(d: &Input, r: &Input) -> bool {
-        d.pkw == r.pkw && d.status == r.status
+    /// A read of a device's own value (spec `per_device`) is equal when code, parameter and
+    /// index are: the response code fixes type and length.
+    fn exact_equal(&self, d: &Input, r: &Input) -> bool {
+        let own = || {
+            d.pkw.ak == r.pkw.ak
+                && d.pkw.pnu == r.pkw.pnu
+                && d.pkw.ind == r.pkw.ind
+                && self.per_device(d.pkw.pnu)
+                && self
+                    .suite
+                    .reference()
+                    .rules()
+                    .pkw()
+                    .response_codes()
+                    .cannot_execute
+                    != d.pkw.ak
+        };
+        d.status == r.status && (d.pkw == r.pkw || own())
     }
 
     fn running_bit(&self) -> u16 {
@@ -185,11 +210,18 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
     /// Records and injections are exact.
     fn same_reply(
         &self,
-        _req: &Request,
+        req: &Request,
         expected: &Reply,
         got: &Reply,
         _tol: Tolerance,
     ) -> (bool, Option<String>) {
+        if let Request::Read { index, .. } = req {
+            if self.per_device(*index) {
+                if let Some(note) = same_length(expected, got) {
+                    return (true, Some(note));
+                }
+            }
+        }
         (expected.to_string() == got.to_string(), None)
     }
 

@@ -5,10 +5,10 @@ use super::cases::{Action, PsxCase, StepDef};
 use super::Psx3xxSuite;
 use crate::case::CaseInfo;
 use crate::cyclic::{Reply, Request, Server};
-use crate::cyclic_session::{CyclicFamily, CyclicSession, Op, Tolerance};
+use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
 use drivespec_psx3xx::isdu::{ErrorType, Request as IsduRequest};
 use drivespec_psx3xx::{Input, Output};
-use drivespec_spec::{Family, FamilyId};
+use drivespec_spec::{DataType, Family, FamilyId};
 
 /// A session on one device under test.
 pub(crate) type Psx3xxSession<'a, 's> = CyclicSession<'a, Psx3xx<'a, 's>>;
@@ -249,7 +249,7 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         (i64::from(i.actual), i64::from(i.rpm), i.status)
     }
 
-    fn exact_equal(d: &Input, r: &Input) -> bool {
+    fn exact_equal(&self, d: &Input, r: &Input) -> bool {
         d.status == r.status
     }
 
@@ -272,6 +272,36 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         got: &Reply,
         tol: Tolerance,
     ) -> (bool, Option<String>) {
+        if let Request::IsduRead { index, .. } = req {
+            let own = self
+                .suite
+                .family()
+                .parameters
+                .iter()
+                .find(|p| p.per_device && p.number == u32::from(*index));
+            if let Some(p) = own {
+                // A string of the device's own may be shorter than the reference's (3.1).
+                let text = match (p.data_type, got) {
+                    (DataType::String, Reply::Data(g)) => p
+                        .length
+                        .and_then(|n| usize::try_from(n).ok())
+                        .is_none_or(|n| g.len() <= n),
+                    _ => false,
+                };
+                if text && matches!(expected, Reply::Data(_)) {
+                    return (
+                        true,
+                        Some(
+                            "the device's own text (the manual gives an example): length"
+                                .to_owned(),
+                        ),
+                    );
+                }
+                if let Some(note) = same_length(expected, got) {
+                    return (true, Some(note));
+                }
+            }
+        }
         match self.error_type_match(expected, got) {
             (false, _) => match self.live_within(req, expected, got, tol) {
                 Some(note) => (true, Some(note)),

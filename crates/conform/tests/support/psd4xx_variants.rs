@@ -20,6 +20,9 @@ pub enum Kind {
     /// A save (par 96 = 1) is answered this many µs after the command came (4.7: "can take up
     /// to 1 second"); meanwhile the drive answers "no response".
     SlowSave(Micros),
+    /// Identity and measured values (spec `per_device`) of its own: another serial number,
+    /// production date, version, temperature, current.
+    OwnValues,
 }
 
 /// The reference PSD 401 with the freedom `kind` taken.
@@ -52,6 +55,15 @@ impl Variant {
             saving_since: None,
         }
     }
+}
+
+/// Whether parameter `number` is the device's own value (spec `per_device`).
+fn per_device(number: u16) -> bool {
+    spec()
+        .family(FamilyId::Psd4xx)
+        .parameters
+        .iter()
+        .any(|p| p.per_device && p.number == u32::from(number))
 }
 
 fn reached_bit() -> u16 {
@@ -114,6 +126,13 @@ impl CyclicDevice<'static> for Variant {
                 self.reached_since = None;
             }
         }
+        if self.kind == Kind::OwnValues
+            && input.pkw.ak != rules.pkw().response_codes().cannot_execute
+            && input.pkw.ak != rules.pkw().response_codes().no_response
+            && per_device(input.pkw.pnu)
+        {
+            input.pkw.pwe ^= 0x0001_0005 & if input.pkw.pwe > 0xFFFF { !0 } else { 0xFFFF };
+        }
         Ok(input.to_bytes(&rules).unwrap())
     }
 
@@ -126,7 +145,21 @@ impl CyclicDevice<'static> for Variant {
         now: Micros,
         req: RecordRequest,
     ) -> Option<Result<RecordAnswer, RecordFailure>> {
-        self.drive.record(now, req)
+        let index = match &req {
+            RecordRequest::Read { index } => Some(*index),
+            RecordRequest::Write { .. } => None,
+        };
+        match (self.kind, self.drive.record(now, req)) {
+            (Kind::OwnValues, Some(Ok(RecordAnswer::Data { mut bytes })))
+                if index.is_some_and(per_device) =>
+            {
+                if let Some(b) = bytes.first_mut() {
+                    *b ^= 0x01;
+                }
+                Some(Ok(RecordAnswer::Data { bytes }))
+            }
+            (_, r) => r,
+        }
     }
 
     fn env(&mut self, now: Micros, env: Env) -> bool {
@@ -147,5 +180,6 @@ pub fn variants() -> Vec<(&'static str, Kind)> {
         ("start latency 30 ms", Kind::StartLatency(30_000)),
         ("bit 0 10 ms after arrival", Kind::ReachedLater(10_000)),
         ("save answered after 900 ms", Kind::SlowSave(900_000)),
+        ("identity and measurements of its own", Kind::OwnValues),
     ]
 }
