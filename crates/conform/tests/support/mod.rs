@@ -14,4 +14,5 @@ pub mod mutants;
 pub mod psd4xx_mutants;
 pub mod psd4xx_variants;
 pub mod psx3xx_mutants;
+pub mod psx3xx_variants;
 pub mod reference_server;

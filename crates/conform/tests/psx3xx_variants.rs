@@ -1,0 +1,44 @@
+//! PSx3xx legal variants (`support::psx3xx_variants`): drives that differ from the reference
+//! only where the manual allows. The cases each variant fails are printed; identification
+//! values of its own must pass every case. A later start is measured only: environment events
+//! timed against the reference's run and position reads during a run still assume the
+//! reference's timing.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+mod support;
+
+use drivespec_conform::case::Outcome;
+use drivespec_conform::cyclic::{LocalPeer, Server};
+use drivespec_conform::psx3xx::Psx3xxSuite;
+use drivespec_conform::suite::{Session, Settings, Suite};
+use support::mutants::spec;
+use support::psx3xx_variants::{variants, Kind, Variant};
+
+#[test]
+fn every_psx3xx_legal_variant_passes() {
+    let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+    let mut problems = Vec::new();
+    for (name, kind) in variants() {
+        let server = Server::new(name, "psx3xx", Box::new(Variant::new(kind)));
+        let mut session = suite.session(Box::new(LocalPeer::new(name, server)));
+        let mut failed = Vec::new();
+        for (i, info) in suite.cases().iter().enumerate() {
+            if let Outcome::Fail(f) = session.run(i).outcome {
+                failed.push(info.id.clone());
+                if !matches!(kind, Kind::StartLatency(_)) {
+                    problems.push(format!(
+                        "{name}: {} failed: {}\n  expected {}\n  got      {}",
+                        info.id, f.message, f.expected, f.got
+                    ));
+                }
+            }
+        }
+        println!("{name:<30} fails {:>3} case(s): {:?}", failed.len(), failed);
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
