@@ -12,7 +12,7 @@ use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, SetupError};
 use drivespec_report::plot::{self, Sample};
 use drivespec_spec::hex::to_hex_compact as hex;
-use drivespec_spec::{Family, FamilyId};
+use drivespec_spec::{Family, FamilyId, RuleAction};
 
 /// Declared tolerances of a case (physics); everything else is exact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -282,6 +282,8 @@ struct Finding {
     reference: Option<usize>,
     /// What differs.
     what: String,
+    /// The requirements the violation breaks, most specific first (cited before the case's).
+    breaks: Vec<String>,
 }
 
 impl Finding {
@@ -291,7 +293,13 @@ impl Finding {
             step,
             reference,
             what,
+            breaks: Vec::new(),
         }
+    }
+
+    fn breaking(mut self, breaks: Vec<String>) -> Finding {
+        self.breaks = breaks;
+        self
     }
 }
 
@@ -789,7 +797,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                             what(x.reference),
                             step_of(&run.cycles, x.theirs)
                         ),
-                    ));
+                    ).breaking(self.bit_rules(bit, x.reference.or(x.device))));
                 }
             }
             let word = |v: Option<i64>| match v {
@@ -922,12 +930,44 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         .reference
                         .and_then(|t| run.cycles.get(t))
                         .map_or(&c.reference, |r| &r.reference);
+                    let mut reqs = f.breaks.clone();
+                    reqs.extend(run.reqs.iter().filter(|r| !f.breaks.contains(r)).cloned());
                     run.failure =
-                        Some(self.cycle_failure(run.reqs, f.cycle, c, reference, f.what.clone()));
+                        Some(self.cycle_failure(&reqs, f.cycle, c, reference, f.what.clone()));
                 }
             }
         }
         bad_steps
+    }
+
+    /// The requirements of status bit `bit`'s rules (spec bitfield `status`): those that make
+    /// it `to` first (set rules for `Some(true)`, reset rules for `Some(false)`).
+    fn bit_rules(&self, bit: u16, to: Option<bool>) -> Vec<String> {
+        let Some(b) = self
+            .family
+            .spec()
+            .bitfield("status")
+            .and_then(|f| f.bits.iter().find(|x| x.bit == u32::from(bit)))
+        else {
+            return Vec::new();
+        };
+        let wanted = match to {
+            Some(true) => Some(RuleAction::Set),
+            Some(false) => Some(RuleAction::Reset),
+            None => None,
+        };
+        let mut ids: Vec<String> = b
+            .rules
+            .iter()
+            .filter(|r| Some(r.action) == wanted)
+            .map(|r| r.requirement.clone())
+            .collect();
+        for r in &b.rules {
+            if !ids.contains(&r.requirement) {
+                ids.push(r.requirement.clone());
+            }
+        }
+        ids
     }
 
     /// The failure of cycle `i` against `reference`, saying `what`.
