@@ -519,7 +519,7 @@ fn commands(g: &mut Gen) {
     );
     cb.action(
         Role::Check,
-        Action::PowerCycle,
+        Action::PowerCycle {},
         "switch the drive off and on",
         &[],
     );
@@ -557,7 +557,7 @@ fn commands(g: &mut Gen) {
         );
         cb.action(
             Role::Check,
-            Action::PowerCycle,
+            Action::PowerCycle {},
             "switch the drive off and on",
             &[],
         );
@@ -585,7 +585,7 @@ fn commands(g: &mut Gen) {
         );
         cb.action(
             Role::Check,
-            Action::PowerCycle,
+            Action::PowerCycle {},
             "switch the drive off and on",
             &[],
         );
@@ -608,7 +608,7 @@ fn commands(g: &mut Gen) {
         );
         cb.action(
             Role::Check,
-            Action::PowerCycle,
+            Action::PowerCycle {},
             "switch the drive off and on",
             &[],
         );
@@ -637,7 +637,7 @@ fn commands(g: &mut Gen) {
         g.bit(&mut cb, Role::Check, &save_ref, true);
         cb.action(
             Role::Check,
-            Action::PowerCycle,
+            Action::PowerCycle {},
             "switch the drive off and on",
             &[],
         );
@@ -660,7 +660,7 @@ fn commands(g: &mut Gen) {
         upload(g, &mut cb, Role::Check, first, &program);
         cb.action(
             Role::Check,
-            Action::PowerCycle,
+            Action::PowerCycle {},
             "switch the drive off and on",
             &[],
         );
@@ -903,7 +903,7 @@ fn baud(g: &mut Gen) {
         );
         cb.action(
             Role::Setup,
-            Action::BitRate,
+            Action::BitRate {},
             format!("switch the line to {} b/s", rate.bps),
             &[],
         );
@@ -918,7 +918,7 @@ fn baud(g: &mut Gen) {
         );
         cb.action(
             Role::Check,
-            Action::ListenTimeout,
+            Action::ListenTimeout {},
             format!("wait past the {} ms time-out", rate.timeout_ms),
             &["HPD-BAUD-002"],
         );
@@ -940,7 +940,7 @@ fn baud(g: &mut Gen) {
         );
         cb.action(
             Role::Check,
-            Action::ListenHalfTimeout,
+            Action::ListenHalfTimeout {},
             format!("wait {} ms, half the time-out", rate.timeout_ms / 2),
             &["HPD-BAUD-002"],
         );
@@ -966,7 +966,12 @@ fn baud(g: &mut Gen) {
             i64::from(v42),
             "Pb42 (b42.3 = 1)",
         );
-        cb.action(Role::Cleanup, Action::BitRate, "switch the line back", &[]);
+        cb.action(
+            Role::Cleanup,
+            Action::BitRate {},
+            "switch the line back",
+            &[],
+        );
         g.restore(&mut cb, pb42, "Pb42");
         g.restore_pb99(&mut cb);
         g.push(cb);
@@ -1053,8 +1058,8 @@ fn vectors(g: &mut Gen) {
                 bytes: request.clone(),
                 compare,
                 silence_ok: v.result == VectorResult::Acceptable,
-                golden,
             },
+            golden,
             text: format!("send {}", drivespec_spec::hex::to_hex(&request)),
             requirements: reqs,
         });

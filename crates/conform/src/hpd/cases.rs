@@ -64,12 +64,13 @@ impl CaseB {
         text: impl Into<String>,
         reqs: &[&str],
     ) {
-        if matches!(action, Action::PowerCycle) {
+        if matches!(action, Action::PowerCycle {}) {
             self.needs_power_cycle = true;
         }
         self.steps.push(Step {
             role,
             action,
+            golden: None,
             text: text.into(),
             requirements: reqs.iter().map(|r| (*r).to_owned()).collect(),
         });
@@ -294,8 +295,8 @@ impl<'s> Gen<'s> {
                 bytes,
                 compare,
                 silence_ok: false,
-                golden: None,
             },
+            golden: None,
             text: text.into(),
             requirements: reqs.iter().map(|s| (*s).to_owned()).collect(),
         });
@@ -327,8 +328,8 @@ impl<'s> Gen<'s> {
                 bytes,
                 compare: Compare::Exact,
                 silence_ok: false,
-                golden: None,
             },
+            golden: None,
             text: text.into(),
             requirements: reqs.iter().map(|s| (*s).to_owned()).collect(),
         });
@@ -466,7 +467,7 @@ impl<'s> Gen<'s> {
         let is_timer = self.protocol.plc.timers.iter().any(|t| t.param == p.id);
         if is_timer {
             // Timers count down every scan (manual 3.8.1): ± 64 scans (about 0.4 s).
-            return Compare::Near { tolerance: 64 };
+            return Compare::Near(64);
         }
         if !p.live {
             return Compare::Exact;

@@ -550,7 +550,7 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
     );
     cb.action(
         Role::Check,
-        Action::ListenTimeout,
+        Action::ListenTimeout {},
         "listen past the message time-out (no answer)",
         &["HPD-FRAME-020"],
     );
@@ -572,7 +572,7 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
     );
     cb.action(
         Role::Check,
-        Action::ListenTimeout,
+        Action::ListenTimeout {},
         "wait past the message time-out",
         &["HPD-BAUD-002"],
     );
@@ -599,7 +599,7 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
     );
     cb.action(
         Role::Check,
-        Action::ListenHalfTimeout,
+        Action::ListenHalfTimeout {},
         "wait half the message time-out",
         &["HPD-BAUD-002"],
     );

@@ -9,11 +9,11 @@
 
 use crate::case::Role;
 use crate::fuzz::engine::{below, chance, pick};
-use crate::fuzz::replay::{Action, Compare, Step};
+use crate::fuzz::replay::{self, Step};
 use crate::hpd::cases::{BitRef, CaseB, Gen};
 use crate::hpd::frame::frame;
 use crate::hpd::names;
-use crate::hpd::step::{Action as HAction, Compare as HCompare, Step as HStep};
+use crate::hpd::step::{Action, Compare, Step as SuiteStep};
 use crate::hpd::HpdSuite;
 use crate::link::{Caps, Micros};
 use crate::rng::Rng;
@@ -297,39 +297,20 @@ impl<'a, 's> HpdGen<'a, 's> {
 
     // ---------------------------------------------------------------- building steps
 
-    fn conv(&self, s: HStep, class: &str) -> Step {
-        let exact = self.exact;
-        let cmp = |c: HCompare| {
-            if exact {
-                return Compare::Exact;
-            }
-            match c {
-                HCompare::Exact => Compare::Exact,
-                HCompare::Mask(m) => Compare::Mask(m),
-                HCompare::Near { tolerance } => Compare::Near(tolerance),
-            }
-        };
+    /// A suite step as a fuzz step of `class`; with `exact`, every exchange compares exactly.
+    fn conv(&self, s: SuiteStep, class: &str) -> Step {
         let action = match s.action {
-            HAction::Exchange {
+            Action::Exchange {
+                bytes, silence_ok, ..
+            } if self.exact => Action::Exchange {
                 bytes,
-                compare,
-                silence_ok,
-                ..
-            } => Action::Exchange {
-                bytes,
-                compare: cmp(compare),
+                compare: Compare::Exact,
                 silence_ok,
             },
-            HAction::Send { bytes } => Action::Send { bytes },
-            HAction::Listen { us } => Action::Listen { us },
-            HAction::ListenTimeout => Action::ListenTimeout,
-            HAction::ListenHalfTimeout => Action::ListenHalfTimeout,
-            HAction::PowerCycle => Action::PowerCycle,
-            HAction::BitRate => Action::BitRate,
-            HAction::Inputs { value } => Action::Inputs { value },
+            other => other,
         };
         Step {
-            action,
+            action: replay::Action::Hpd(action),
             class: class.to_owned(),
             text: s.text,
             requirements: s.requirements,
@@ -343,7 +324,7 @@ impl<'a, 's> HpdGen<'a, 's> {
         self.g.errors.clear();
     }
 
-    fn msg(&mut self, out: &mut Vec<Step>, class: &str, m: Message, cmp: HCompare, text: String) {
+    fn msg(&mut self, out: &mut Vec<Step>, class: &str, m: Message, cmp: Compare, text: String) {
         let mut cb = CaseB::new("hpd/fuzz", "", &[]);
         self.g.msg(&mut cb, Role::Check, m, cmp, text);
         self.take(out, cb, class);
@@ -367,7 +348,7 @@ impl<'a, 's> HpdGen<'a, 's> {
 
     fn step(&self, out: &mut Vec<Step>, class: &str, action: Action, text: String, reqs: &[&str]) {
         out.push(Step {
-            action,
+            action: replay::Action::Hpd(action),
             class: class.to_owned(),
             text,
             requirements: reqs.iter().map(|r| (*r).to_owned()).collect(),
@@ -413,7 +394,7 @@ impl<'a, 's> HpdGen<'a, 's> {
         out
     }
 
-    fn compare_of(&self, slot: Slot) -> HCompare {
+    fn compare_of(&self, slot: Slot) -> Compare {
         match self.g.family.parameter_at_address(u32::from(slot.addr)) {
             Some(p)
                 if p.address == Some(u32::from(slot.addr))
@@ -421,7 +402,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             {
                 self.g.compare_for(p, None)
             }
-            _ => HCompare::Exact,
+            _ => Compare::Exact,
         }
     }
 
@@ -446,7 +427,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 out,
                 class,
                 m,
-                HCompare::Exact,
+                Compare::Exact,
                 format!("write {what} = {value}"),
             );
         }
@@ -666,7 +647,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 self.step(
                     out,
                     "power-cycle",
-                    Action::PowerCycle,
+                    Action::PowerCycle {},
                     "switch the drive off and on".to_owned(),
                     &["HPD-PAR-018"],
                 );
@@ -762,7 +743,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 out,
                 "odd-read",
                 m,
-                HCompare::Exact,
+                Compare::Exact,
                 format!("read {lun} byte(s) at {par:#04x}"),
             );
         }
@@ -867,7 +848,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             value: rng.byte(),
         };
         let text = format!("bit change on byte {off} of {}", p.id);
-        self.msg(out, "bit-change-raw", m, HCompare::Exact, text);
+        self.msg(out, "bit-change-raw", m, Compare::Exact, text);
         self.read_slot(out, "valid-read", s, &p.id);
     }
 
@@ -946,7 +927,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "broadcast",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("broadcast {what} = {v}"),
         );
         if chance(rng, 80) {
@@ -1140,7 +1121,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             self.step(
                 out,
                 "truncated",
-                Action::ListenTimeout,
+                Action::ListenTimeout {},
                 "listen past the message time-out".to_owned(),
                 &["HPD-FRAME-020", "HPD-BAUD-003"],
             );
@@ -1266,13 +1247,13 @@ impl<'a, 's> HpdGen<'a, 's> {
         let (class, pause, text, reqs): (&str, Action, &str, &[&str]) = match rng.range(0, 2) {
             0 => (
                 "split-timeout",
-                Action::ListenTimeout,
+                Action::ListenTimeout {},
                 "wait past the message time-out",
                 &["HPD-BAUD-002", "HPD-BAUD-003", "HPD-FRAME-020"],
             ),
             1 => (
                 "split-within",
-                Action::ListenHalfTimeout,
+                Action::ListenHalfTimeout {},
                 "wait half the message time-out",
                 &["HPD-BAUD-002", "HPD-FRAME-020"],
             ),
@@ -1329,7 +1310,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             self.step(
                 out,
                 "noise",
-                Action::ListenTimeout,
+                Action::ListenTimeout {},
                 "let the noise time out".to_owned(),
                 &["HPD-FRAME-020"],
             );
@@ -1374,7 +1355,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "plc-read",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("read {lun} PLC byte(s) at {par:#04x}"),
         );
     }
@@ -1639,7 +1620,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 out,
                 c,
                 m,
-                HCompare::Exact,
+                Compare::Exact,
                 format!("write {n} PLC byte(s) at {par:#04x}"),
             );
         }
@@ -1741,7 +1722,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                     out,
                     "plc-read",
                     m,
-                    HCompare::Exact,
+                    Compare::Exact,
                     format!("read back PLC bytes at {at:#04x}"),
                 );
                 at += lun;
@@ -1770,7 +1751,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "plc-write-running",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("write an instruction at {at:#04x} (PLC as it is)"),
         );
         let lun = data.len();
@@ -1783,7 +1764,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "plc-read",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("read PLC bytes at {at:#04x}"),
         );
     }
