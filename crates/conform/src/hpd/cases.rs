@@ -104,6 +104,30 @@ pub(crate) struct BitRef<'s> {
     pub(crate) at: BitAddr,
 }
 
+/// Why the HPD cases or fuzz sequences cannot be generated from the spec.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GenError {
+    /// The spec has no HPD protocol table.
+    #[error("no HPD protocol table")]
+    NoProtocol,
+    /// The framing rules cannot be read from the spec.
+    #[error(transparent)]
+    Rules(#[from] drivespec_hpd::RulesError),
+    /// The spec has no PLC tables (manual appendix G).
+    #[error("no PLC tables")]
+    NoPlc,
+    /// The protocol table's PLC run bit is not a bit of the spec.
+    #[error("PLC run bit {0:?} is not a bit of the spec")]
+    RunBit(String),
+    /// The reference drive cannot be built from the spec.
+    #[error(transparent)]
+    Model(#[from] drivespec_hpd::model::ModelError),
+    /// Cases that cannot be built (a message the spec's values do not encode).
+    #[error("{} problem(s) generating HPD cases, first: {}", .0.len(), .0.first().map_or("", String::as_str))]
+    Cases(Vec<String>),
+}
+
 impl<'s> Gen<'s> {
     pub(crate) fn new(
         spec: &'s Spec,
@@ -111,11 +135,11 @@ impl<'s> Gen<'s> {
         model: Option<&'s drivespec_spec::DeviceModel>,
         addr: u8,
         seed: u64,
-    ) -> Result<Gen<'s>, String> {
+    ) -> Result<Gen<'s>, GenError> {
         let family = spec.family(FamilyId::Hpd);
-        let protocol = family.hpd().ok_or("no HPD protocol table")?;
-        let rules = FrameRules::from_spec(spec).map_err(|e| e.to_string())?;
-        let codec = PlcCodec::from_spec(spec).ok_or("no PLC tables")?;
+        let protocol = family.hpd().ok_or(GenError::NoProtocol)?;
+        let rules = FrameRules::from_spec(spec)?;
+        let codec = PlcCodec::from_spec(spec).ok_or(GenError::NoPlc)?;
         let map = ParamMap::from_spec(spec);
         let mut g = Gen {
             family,
@@ -131,7 +155,9 @@ impl<'s> Gen<'s> {
             errors: Vec::new(),
             run: (Slot { addr: 0, size: 0 }, BitAddr { byte: 0, mask: 0 }),
         };
-        let run = g.bit_ref(&protocol.plc.run_bit).ok_or("no PLC run bit")?;
+        let run = g
+            .bit_ref(&protocol.plc.run_bit)
+            .ok_or_else(|| GenError::RunBit(protocol.plc.run_bit.clone()))?;
         g.run = (run.slot, run.at);
         Ok(g)
     }
@@ -640,4 +666,28 @@ pub(crate) fn sign_for(slot: Slot, raw: u32, family: &Family) -> i64 {
 pub(crate) fn bit_value(slot: Slot, at: BitAddr) -> u32 {
     let shift = 8 * u32::from(at.byte.saturating_sub(slot.addr));
     u32::from(at.mask).checked_shl(shift).unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::suite::SetupError;
+
+    #[test]
+    fn generation_errors_name_what_is_missing() {
+        let e = GenError::Cases(vec!["first".into(), "second".into()]);
+        assert_eq!(
+            e.to_string(),
+            "2 problem(s) generating HPD cases, first: first"
+        );
+        let e = SetupError::from(GenError::RunBit("b99.x".into()));
+        assert_eq!(
+            e.to_string(),
+            "spec: PLC run bit \"b99.x\" is not a bit of the spec"
+        );
+        assert_eq!(
+            SetupError::from(GenError::NoProtocol).to_string(),
+            "spec: no HPD protocol table"
+        );
+    }
 }

@@ -12,7 +12,7 @@ use crate::case::{CaseInfo, CaseRun, Failure, Outcome, RequirementRef, Role};
 use crate::fuzz::engine::{self, Fault, Target, Trial};
 use crate::fuzz::replay::{Action, FindingClass, Start, Step};
 use crate::hpd::step::{Action as HAction, HpdCase, Step as HStep};
-use crate::hpd::{HpdSession, HpdSuite};
+use crate::hpd::{GenError, HpdSession, HpdSuite};
 use crate::link::{Caps, Link, LinkError, Recovered};
 use crate::rng::Rng;
 use crate::suite::SetupError;
@@ -44,9 +44,8 @@ impl<'a, 's> HpdTarget<'a, 's> {
         link: Box<dyn Link>,
     ) -> Result<HpdTarget<'a, 's>, SetupError> {
         let caps = link.caps();
-        let rules =
-            FrameRules::from_spec(suite.spec()).map_err(|e| SetupError::Spec(e.to_string()))?;
-        let mut gen = HpdGen::new(suite, caps).map_err(SetupError::Spec)?;
+        let rules = FrameRules::from_spec(suite.spec()).map_err(GenError::from)?;
+        let mut gen = HpdGen::new(suite, caps)?;
         let probe = gen.probe();
         Ok(HpdTarget {
             family: suite.family(),

@@ -10,7 +10,7 @@
 use crate::case::Role;
 use crate::fuzz::engine::{below, chance, pick};
 use crate::fuzz::replay::{self, Step};
-use crate::hpd::cases::{BitRef, CaseB, Gen};
+use crate::hpd::cases::{BitRef, CaseB, Gen, GenError};
 use crate::hpd::frame::frame;
 use crate::hpd::names;
 use crate::hpd::step::{Action, Compare, Step as SuiteStep};
@@ -135,7 +135,7 @@ fn parse_bit(name: &str) -> Option<(u8, u8)> {
 
 impl<'a, 's> HpdGen<'a, 's> {
     /// A generator for the device the suite was made for, on a transport with `caps`.
-    pub(crate) fn new(suite: &'a HpdSuite<'s>, caps: Caps) -> Result<HpdGen<'a, 's>, String> {
+    pub(crate) fn new(suite: &'a HpdSuite<'s>, caps: Caps) -> Result<HpdGen<'a, 's>, GenError> {
         let spec = suite.spec();
         let family = suite.family();
         let model = suite.model_id().and_then(|m| family.model(m));
@@ -256,7 +256,8 @@ impl<'a, 's> HpdGen<'a, 's> {
             }
             i += 1;
         }
-        let run_bit = parse_bit(&protocol.plc.run_bit).ok_or("PLC run bit not a bit")?;
+        let run_bit = parse_bit(&protocol.plc.run_bit)
+            .ok_or_else(|| GenError::RunBit(protocol.plc.run_bit.clone()))?;
         let dword_bit = g.bit_ref(&arith.dword_force_bit);
         let inputs = u32::try_from(protocol.io.inputs.len()).unwrap_or(8).min(16);
         let scan_us = Micros::from(protocol.plc.scan_us);
