@@ -517,12 +517,7 @@ fn commands(g: &mut Gen) {
         "read Pr2: no answer, the line is disabled",
         &["HPD-BIT-40-14-DEFAULT", "HPD-BIT-40-14"],
     );
-    cb.action(
-        Role::Check,
-        Action::PowerCycle {},
-        "switch the drive off and on",
-        &[],
-    );
+    cb.power_cycle();
     g.read(
         &mut cb,
         Role::Check,
@@ -555,12 +550,7 @@ fn commands(g: &mut Gen) {
             "read Pr80: no answer",
             &["HPD-BIT-40-14"],
         );
-        cb.action(
-            Role::Check,
-            Action::PowerCycle {},
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         g.read(&mut cb, Role::Check, scratch, Compare::Exact, "Pr80");
         g.push(cb);
     }
@@ -583,12 +573,7 @@ fn commands(g: &mut Gen) {
             later,
             "Pr80 (working value only)",
         );
-        cb.action(
-            Role::Check,
-            Action::PowerCycle {},
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         g.read(&mut cb, Role::Check, scratch, Compare::Exact, "Pr80");
         g.restore(&mut cb, scratch, "Pr80");
         g.bit(&mut cb, Role::Cleanup, &save_ref, true);
@@ -606,12 +591,7 @@ fn commands(g: &mut Gen) {
             value,
             "Pr80 (working value only)",
         );
-        cb.action(
-            Role::Check,
-            Action::PowerCycle {},
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         g.read(
             &mut cb,
             Role::Check,
@@ -635,12 +615,7 @@ fn commands(g: &mut Gen) {
         g.stop_plc(&mut cb);
         upload(g, &mut cb, Role::Setup, first, &program);
         g.bit(&mut cb, Role::Check, &save_ref, true);
-        cb.action(
-            Role::Check,
-            Action::PowerCycle {},
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         read_plc(g, &mut cb, first, program.len());
         g.stop_plc(&mut cb);
         if let Some(s) = cb.steps.last_mut() {
@@ -658,12 +633,7 @@ fn commands(g: &mut Gen) {
         );
         g.stop_plc(&mut cb);
         upload(g, &mut cb, Role::Check, first, &program);
-        cb.action(
-            Role::Check,
-            Action::PowerCycle {},
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         read_plc(g, &mut cb, first, program.len());
         g.push(cb);
     }
@@ -908,16 +878,8 @@ fn baud(g: &mut Gen) {
             &[],
         );
         g.read(&mut cb, Role::Check, pr26, Compare::Exact, "Pr26");
-        cb.action(
-            Role::Check,
-            Action::Send {
-                bytes: head.clone(),
-            },
-            "send the first 3 bytes of a read of Pr33",
-            &[],
-        );
-        cb.action(
-            Role::Check,
+        cb.split_read(
+            &head,
             Action::ListenTimeout {},
             format!("wait past the {} ms time-out", rate.timeout_ms),
             &["HPD-BAUD-002"],
@@ -930,16 +892,8 @@ fn baud(g: &mut Gen) {
             &["HPD-BAUD-003", "HPD-FRAME-020"],
         );
         g.read(&mut cb, Role::Check, ranged, Compare::Exact, "Pr33");
-        cb.action(
-            Role::Check,
-            Action::Send {
-                bytes: head.clone(),
-            },
-            "send the first 3 bytes of a read of Pr33",
-            &[],
-        );
-        cb.action(
-            Role::Check,
+        cb.split_read(
+            &head,
             Action::ListenHalfTimeout {},
             format!("wait {} ms, half the time-out", rate.timeout_ms / 2),
             &["HPD-BAUD-002"],

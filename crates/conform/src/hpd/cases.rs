@@ -75,6 +75,36 @@ impl CaseB {
             requirements: reqs.iter().map(|r| (*r).to_owned()).collect(),
         });
     }
+
+    /// Switches the drive off and on (a check step).
+    pub(crate) fn power_cycle(&mut self) {
+        self.action(
+            Role::Check,
+            Action::PowerCycle {},
+            "switch the drive off and on",
+            &[],
+        );
+    }
+
+    /// Sends `head`, the first 3 bytes of a read of Pr33, then pauses with `pause`
+    /// (manual 4.1: a message must be complete within the Pr26 time-out).
+    pub(crate) fn split_read(
+        &mut self,
+        head: &[u8],
+        pause: Action,
+        text: impl Into<String>,
+        reqs: &[&str],
+    ) {
+        self.action(
+            Role::Check,
+            Action::Send {
+                bytes: head.to_vec(),
+            },
+            "send the first 3 bytes of a read of Pr33",
+            &[],
+        );
+        self.action(Role::Check, pause, text, reqs);
+    }
 }
 
 /// Everything fixed while cases are generated.

@@ -540,16 +540,8 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
         "a read that stops after 3 bytes gets no answer; after the time-out the next read is answered",
         &["HPD-BAUD-003", "HPD-FRAME-020"],
     );
-    cb.action(
-        Role::Check,
-        Action::Send {
-            bytes: head.clone(),
-        },
-        "send the first 3 bytes of a read of Pr33",
-        &[],
-    );
-    cb.action(
-        Role::Check,
+    cb.split_read(
+        &head,
         Action::ListenTimeout {},
         "listen past the message time-out (no answer)",
         &["HPD-FRAME-020"],
@@ -562,16 +554,8 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
         "a read split by a pause longer than the Pr26 time-out is dropped: no answer to either part",
         &["HPD-BAUD-002", "HPD-BAUD-003", "HPD-FRAME-020"],
     );
-    cb.action(
-        Role::Check,
-        Action::Send {
-            bytes: head.clone(),
-        },
-        "send the first 3 bytes of a read of Pr33",
-        &[],
-    );
-    cb.action(
-        Role::Check,
+    cb.split_read(
+        &head,
         Action::ListenTimeout {},
         "wait past the message time-out",
         &["HPD-BAUD-002"],
@@ -591,14 +575,8 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
         "a read split by a pause of half the time-out is complete in time and answered",
         &["HPD-BAUD-002", "HPD-FRAME-020"],
     );
-    cb.action(
-        Role::Check,
-        Action::Send { bytes: head },
-        "send the first 3 bytes of a read of Pr33",
-        &[],
-    );
-    cb.action(
-        Role::Check,
+    cb.split_read(
+        &head,
         Action::ListenHalfTimeout {},
         "wait half the message time-out",
         &["HPD-BAUD-002"],
