@@ -504,16 +504,10 @@ fn commands(g: &mut Gen) {
     g.stop_plc(&mut cb);
     g.write(&mut cb, Role::Setup, with_default, v2, "Pr2");
     g.bit(&mut cb, Role::Check, &defaults, true);
-    let msg = Message::ReadParam {
-        addr: own,
-        lun: with_default.size,
-        par: with_default.addr,
-    };
-    let b = g.bytes(&msg);
-    g.raw(
+    g.raw_read(
         &mut cb,
-        Role::Check,
-        b,
+        own,
+        with_default,
         "read Pr2: no answer, the line is disabled",
         &["HPD-BIT-40-14-DEFAULT", "HPD-BIT-40-14"],
     );
@@ -537,16 +531,10 @@ fn commands(g: &mut Gen) {
             &["HPD-BIT-40-14"],
         );
         g.bit(&mut cb, Role::Check, &enable, false);
-        let msg = Message::ReadParam {
-            addr: own,
-            lun: scratch.size,
-            par: scratch.addr,
-        };
-        let b = g.bytes(&msg);
-        g.raw(
+        g.raw_read(
             &mut cb,
-            Role::Check,
-            b,
+            own,
+            scratch,
             "read Pr80: no answer",
             &["HPD-BIT-40-14"],
         );
@@ -700,16 +688,10 @@ fn commands(g: &mut Gen) {
     g.write(&mut cb, Role::Setup, pr27, i64::from(other), "Pr27");
     g.bit(&mut cb, Role::Check, &reinit, true);
     g.read(&mut cb, Role::Check, ranged, Compare::Exact, "Pr33");
-    let msg = Message::ReadParam {
-        addr: other,
-        lun: ranged.size,
-        par: ranged.addr,
-    };
-    let b = g.bytes(&msg);
-    g.raw(
+    g.raw_read(
         &mut cb,
-        Role::Check,
-        b,
+        other,
+        ranged,
         format!("read Pr33 from drive {other}: no answer"),
         &["HPD-SERIAL-003"],
     );
@@ -723,16 +705,10 @@ fn commands(g: &mut Gen) {
         &["HPD-BIT-42-3", "HPD-PAR-038", "HPD-SERIAL-003", "HPD-SERIAL-009", "HPD-SERIAL-002"],
     );
     g.readdress(&mut cb, Role::Setup, own, other);
-    let msg = Message::ReadParam {
-        addr: own,
-        lun: ranged.size,
-        par: ranged.addr,
-    };
-    let b = g.bytes(&msg);
-    g.raw(
+    g.raw_read(
         &mut cb,
-        Role::Check,
-        b,
+        own,
+        ranged,
         format!("read Pr33 from drive {own}: no answer"),
         &["HPD-SERIAL-003"],
     );

@@ -391,6 +391,25 @@ impl<'s> Gen<'s> {
         });
     }
 
+    /// A read of `slot` addressed to drive `addr`, as raw bytes with the requirements given
+    /// (a read the drive must not answer).
+    pub(crate) fn raw_read(
+        &mut self,
+        cb: &mut CaseB,
+        addr: u8,
+        slot: Slot,
+        text: impl Into<String>,
+        reqs: &[&str],
+    ) {
+        let msg = Message::ReadParam {
+            addr,
+            lun: slot.size,
+            par: slot.addr,
+        };
+        let bytes = self.bytes(&msg);
+        self.raw(cb, Role::Check, bytes, text, reqs);
+    }
+
     fn touch(&self, cb: &mut CaseB, par: u8, len: u8) {
         for i in 0..len {
             let Some(a) = par.checked_add(i) else { break };

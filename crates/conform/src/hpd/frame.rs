@@ -61,6 +61,12 @@ fn still_answers(g: &mut Gen, cb: &mut CaseB, slot: Slot) {
     );
 }
 
+/// Pr80 is read back unchanged, then restored.
+fn unchanged(g: &mut Gen, cb: &mut CaseB, scratch: Slot) {
+    g.read(cb, Role::Check, scratch, Compare::Exact, "Pr80 (unchanged)");
+    g.restore(cb, scratch, "Pr80");
+}
+
 fn message_types(
     g: &mut Gen,
     ranged: Slot,
@@ -359,14 +365,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
             &["HPD-SERIAL-012", "HPD-FRAME-009"],
         );
         if writes {
-            g.read(
-                &mut cb,
-                Role::Check,
-                scratch,
-                Compare::Exact,
-                "Pr80 (unchanged)",
-            );
-            g.restore(&mut cb, scratch, "Pr80");
+            unchanged(g, &mut cb, scratch);
         } else {
             still_answers(g, &mut cb, ranged);
         }
@@ -382,14 +381,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
         let bytes = frame(g, &fields, None);
         g.raw(&mut cb, Role::Check, bytes, text.to_owned(), reqs);
         if check == scratch {
-            g.read(
-                &mut cb,
-                Role::Check,
-                scratch,
-                Compare::Exact,
-                "Pr80 (unchanged)",
-            );
-            g.restore(&mut cb, scratch, "Pr80");
+            unchanged(g, &mut cb, scratch);
         } else {
             still_answers(g, &mut cb, ranged);
         }
@@ -493,14 +485,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
         "send Pr80 = $7E without stuffing",
         &["HPD-FRAME-003", "HPD-SERIAL-012"],
     );
-    g.read(
-        &mut cb,
-        Role::Check,
-        scratch,
-        Compare::Exact,
-        "Pr80 (unchanged)",
-    );
-    g.restore(&mut cb, scratch, "Pr80");
+    unchanged(g, &mut cb, scratch);
     g.push(cb);
 
     let wrong = {
@@ -520,14 +505,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
         "send $7E $01 inside a write",
         &["HPD-FRAME-004", "HPD-SERIAL-012"],
     );
-    g.read(
-        &mut cb,
-        Role::Check,
-        scratch,
-        Compare::Exact,
-        "Pr80 (unchanged)",
-    );
-    g.restore(&mut cb, scratch, "Pr80");
+    unchanged(g, &mut cb, scratch);
     g.push(cb);
 }
 
@@ -676,16 +654,10 @@ fn foreign(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
             format!("a read addressed to drive {other} gets no answer from drive {own}"),
             &["HPD-SERIAL-003", "HPD-SERIAL-002"],
         );
-        let msg = Message::ReadParam {
-            addr: other,
-            lun: ranged.size,
-            par: ranged.addr,
-        };
-        let b = g.bytes(&msg);
-        g.raw(
+        g.raw_read(
             &mut cb,
-            Role::Check,
-            b,
+            other,
+            ranged,
             format!("read Pr33 from drive {other}"),
             &["HPD-SERIAL-003"],
         );
@@ -712,13 +684,6 @@ fn foreign(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
             &["HPD-SERIAL-003"],
         );
     }
-    g.read(
-        &mut cb,
-        Role::Check,
-        scratch,
-        Compare::Exact,
-        "Pr80 (unchanged)",
-    );
-    g.restore(&mut cb, scratch, "Pr80");
+    unchanged(g, &mut cb, scratch);
     g.push(cb);
 }
