@@ -248,6 +248,15 @@ impl<'s> Gen<'s> {
         self.family.resolve(p, self.model).range
     }
 
+    /// The operating modes in which `p` has a range of its own (manual 3.6).
+    pub(crate) fn ranged_modes(p: &Parameter) -> Vec<u32> {
+        p.modes
+            .iter()
+            .filter(|m| m.range.is_some())
+            .flat_map(|m| m.modes.iter().copied())
+            .collect()
+    }
+
     /// The requirement IDs in the spec (so cases never cite a missing one).
     pub(crate) fn known(&self, id: &str) -> bool {
         self.family.requirement(id).is_some()

@@ -776,12 +776,7 @@ impl<'a, 's> HpdGen<'a, 's> {
         let Some((p, s)) = pick(rng, &self.moded).copied() else {
             return;
         };
-        let modes: Vec<u32> = p
-            .modes
-            .iter()
-            .filter(|m| m.range.is_some())
-            .flat_map(|m| m.modes.iter().copied())
-            .collect();
+        let modes = Gen::ranged_modes(p);
         let (Some(&mode), Some(ms)) = (pick(rng, &modes), self.g.slot_of(names::OPERATING_MODE))
         else {
             return;
