@@ -51,7 +51,46 @@ pub struct DutError {
     /// The text given.
     pub text: String,
     /// What is wrong.
-    pub why: String,
+    pub why: DutProblem,
+}
+
+/// What is wrong with a `--dut` text.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DutProblem {
+    /// `serial:` without a path.
+    #[error("no port path")]
+    NoPortPath,
+    /// `baud=` with something else than a number.
+    #[error("baud is not a number")]
+    BaudNotNumber,
+    /// A `serial:` option other than `baud`.
+    #[error("unknown option {0:?} (known: baud)")]
+    UnknownOption(String),
+    /// `tcp:` without `HOST:PORT`.
+    #[error("expected tcp:HOST:PORT")]
+    NotHostPort,
+    /// `exec:` with a command line that does not split into words.
+    #[error("{0}")]
+    Command(#[from] SplitError),
+    /// `exec:` without a command.
+    #[error("no command")]
+    NoCommand,
+    /// Not `sim`, `serial`, `tcp` or `exec`.
+    #[error("unknown transport")]
+    UnknownTransport,
+}
+
+/// Why a command line does not split into words ([`split_command`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SplitError {
+    /// A quote (`'` or `"`) without its closing one.
+    #[error("unterminated {0} quote")]
+    Unterminated(char),
+    /// A `\` at the end.
+    #[error("trailing backslash")]
+    TrailingBackslash,
 }
 
 impl FromStr for Dut {
@@ -59,9 +98,9 @@ impl FromStr for Dut {
 
     fn from_str(s: &str) -> Result<Dut, DutError> {
         let text = s.trim();
-        let bad = |why: &str| DutError {
+        let bad = |why: DutProblem| DutError {
             text: text.to_owned(),
-            why: why.to_owned(),
+            why,
         };
         let (kind, rest) = text.split_once(':').unwrap_or((text, ""));
         match kind.to_ascii_lowercase().as_str() {
@@ -73,15 +112,18 @@ impl FromStr for Dut {
             "serial" => {
                 let (path, query) = rest.split_once('?').unwrap_or((rest, ""));
                 if path.trim().is_empty() {
-                    return Err(bad("no port path"));
+                    return Err(bad(DutProblem::NoPortPath));
                 }
                 let mut baud = None;
                 for pair in query.split('&').filter(|p| !p.is_empty()) {
                     match pair.split_once('=') {
                         Some(("baud", v)) => {
-                            baud = Some(v.parse::<u32>().map_err(|_| bad("baud is not a number"))?)
+                            baud = Some(
+                                v.parse::<u32>()
+                                    .map_err(|_| bad(DutProblem::BaudNotNumber))?,
+                            )
                         }
-                        _ => return Err(bad(&format!("unknown option {pair:?} (known: baud)"))),
+                        _ => return Err(bad(DutProblem::UnknownOption(pair.to_owned()))),
                     }
                 }
                 Ok(Dut::Serial {
@@ -94,20 +136,20 @@ impl FromStr for Dut {
                     .rsplit_once(':')
                     .is_some_and(|(h, p)| !h.is_empty() && p.parse::<u16>().is_ok());
                 if !ok {
-                    return Err(bad("expected tcp:HOST:PORT"));
+                    return Err(bad(DutProblem::NotHostPort));
                 }
                 Ok(Dut::Tcp {
                     addr: rest.to_owned(),
                 })
             }
             "exec" => {
-                let argv = split_command(rest).map_err(bad)?;
+                let argv = split_command(rest).map_err(|e| bad(e.into()))?;
                 if argv.is_empty() {
-                    return Err(bad("no command"));
+                    return Err(bad(DutProblem::NoCommand));
                 }
                 Ok(Dut::Exec { argv })
             }
-            _ => Err(bad("unknown transport")),
+            _ => Err(bad(DutProblem::UnknownTransport)),
         }
     }
 }
@@ -132,7 +174,7 @@ impl fmt::Display for Dut {
 }
 
 /// Splits a command line into words: blanks separate, `'…'` and `"…"` quote, `\` escapes.
-pub fn split_command(s: &str) -> Result<Vec<String>, &'static str> {
+pub fn split_command(s: &str) -> Result<Vec<String>, SplitError> {
     let mut words = Vec::new();
     let mut cur = String::new();
     let mut in_word = false;
@@ -145,7 +187,7 @@ pub fn split_command(s: &str) -> Result<Vec<String>, &'static str> {
                     match chars.next() {
                         Some('\'') => break,
                         Some(c) => cur.push(c),
-                        None => return Err("unterminated ' quote"),
+                        None => return Err(SplitError::Unterminated('\'')),
                     }
                 }
             }
@@ -156,10 +198,10 @@ pub fn split_command(s: &str) -> Result<Vec<String>, &'static str> {
                         Some('"') => break,
                         Some('\\') => match chars.next() {
                             Some(c) => cur.push(c),
-                            None => return Err("trailing backslash"),
+                            None => return Err(SplitError::TrailingBackslash),
                         },
                         Some(c) => cur.push(c),
-                        None => return Err("unterminated \" quote"),
+                        None => return Err(SplitError::Unterminated('"')),
                     }
                 }
             }
@@ -167,7 +209,7 @@ pub fn split_command(s: &str) -> Result<Vec<String>, &'static str> {
                 in_word = true;
                 match chars.next() {
                     Some(c) => cur.push(c),
-                    None => return Err("trailing backslash"),
+                    None => return Err(SplitError::TrailingBackslash),
                 }
             }
             c if c.is_whitespace() => {
@@ -220,16 +262,27 @@ mod tests {
                 argv: vec!["python3".into(), "my adapter.py".into(), "--x".into()]
             }
         );
-        for bad in [
-            "tcp:host",
-            "serial:",
-            "serial:/dev/x?speed=1",
-            "exec:",
-            "exec:'x",
-            "usb:1",
+        for (bad, why) in [
+            ("tcp:host", DutProblem::NotHostPort),
+            ("serial:", DutProblem::NoPortPath),
+            ("serial:/dev/x?baud=fast", DutProblem::BaudNotNumber),
+            (
+                "serial:/dev/x?speed=1",
+                DutProblem::UnknownOption("speed=1".into()),
+            ),
+            ("exec:", DutProblem::NoCommand),
+            ("exec:'x", SplitError::Unterminated('\'').into()),
+            ("exec:\"x", SplitError::Unterminated('"').into()),
+            ("exec:x\\", SplitError::TrailingBackslash.into()),
+            ("usb:1", DutProblem::UnknownTransport),
         ] {
-            assert!(bad.parse::<Dut>().is_err(), "{bad}");
+            assert_eq!(bad.parse::<Dut>().map_err(|e| e.why), Err(why), "{bad}");
         }
+        let e = "exec:'x".parse::<Dut>().unwrap_err().to_string();
+        assert!(
+            e.starts_with("--dut \"exec:'x\": unterminated ' quote ("),
+            "{e}"
+        );
     }
 
     #[test]

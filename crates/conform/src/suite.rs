@@ -28,7 +28,7 @@ pub struct Settings {
 }
 
 /// Why a suite or a session cannot be set up.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SetupError {
     /// The transport cannot be opened.
@@ -40,6 +40,9 @@ pub enum SetupError {
     /// The spec lacks what the suite needs.
     #[error("spec: {0}")]
     Spec(String),
+    /// The spec lacks what the HPD cases or fuzz sequences need.
+    #[error("spec: {0}")]
+    Hpd(#[from] crate::hpd::GenError),
 }
 
 impl From<drivespec_sim::reference::ReferenceError> for SetupError {

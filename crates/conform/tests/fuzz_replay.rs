@@ -11,8 +11,9 @@
 mod support;
 
 use drivespec_conform::dut::Dut;
-use drivespec_conform::fuzz::{self, Action, Compare, Options, Replay, Step};
+use drivespec_conform::fuzz::{self, Action, Options, Replay, Step};
 use drivespec_conform::Progress;
+use drivespec_hpd::step::{Compare, Step as HpdStep};
 use drivespec_sim::SimLink;
 use std::path::PathBuf;
 use support::mutants::{spec, Kind, Mutant};
@@ -87,7 +88,7 @@ fn replays_are_deterministic_and_minimise() {
 
     // Padding in front and behind is minimised away again.
     let read = |par: u8| Step {
-        action: Action::Exchange {
+        action: Action::Hpd(HpdStep::Exchange {
             bytes: drivespec_hpd::Message::ReadParam {
                 addr: 0,
                 lun: 2,
@@ -97,7 +98,7 @@ fn replays_are_deterministic_and_minimise() {
             .unwrap(),
             compare: Compare::Exact,
             silence_ok: false,
-        },
+        }),
         class: "valid-read".into(),
         text: "padding".into(),
         requirements: vec![],

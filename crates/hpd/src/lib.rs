@@ -14,6 +14,7 @@ pub mod params;
 pub mod plc;
 mod repr;
 mod rules;
+pub mod step;
 mod wire;
 
 pub use error::{EmitError, FrameError};

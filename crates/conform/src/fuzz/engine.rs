@@ -12,6 +12,7 @@ use super::stats::Stats;
 use crate::case::{CaseRun, Failure, RequirementRef};
 use crate::link::{Caps, LinkError};
 use crate::rng::Rng;
+use drivespec_hpd::step::Step as HpdStep;
 use drivespec_spec::{Family, FamilyId, Level};
 
 /// What one run of a sequence found.
@@ -434,7 +435,7 @@ pub(crate) fn pick<'x, T>(rng: &mut Rng, items: &'x [T]) -> Option<&'x T> {
 pub(crate) fn is_exchange(s: &Step) -> bool {
     matches!(
         s.action,
-        Action::Exchange { .. } | Action::Send { .. } | Action::Cyclic(_)
+        Action::Hpd(HpdStep::Exchange { .. } | HpdStep::Send { .. }) | Action::Cyclic(_)
     )
 }
 

@@ -28,8 +28,8 @@ mod stats;
 
 pub use output::{json as report_json, Finding};
 pub use replay::{
-    Action, Compare, CyclicStep, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start,
-    Step, REPLAY_FORMAT,
+    Action, CyclicStep, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start, Step,
+    REPLAY_FORMAT,
 };
 pub use stats::{FindingSummary, Stats, STATS_SCHEMA};
 

@@ -8,6 +8,7 @@
 use crate::case::Record;
 use crate::cyclic::{Env, Request};
 use crate::link::Micros;
+use drivespec_hpd::step::Step as HpdStep;
 use drivespec_spec::hex::{parse_hex, to_hex};
 use drivespec_spec::FamilyId;
 use serde::{Deserialize, Serialize};
@@ -16,55 +17,11 @@ use std::path::Path;
 /// Name and version of the replay format (README "Replay files").
 pub const REPLAY_FORMAT: &str = "drivespec-fuzz-replay/1";
 
-/// How an answer is compared with the reference's (as `conform` does, README "Cases").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Compare {
-    /// Byte for byte, silence included.
-    #[default]
-    Exact,
-    /// The same frame; data bits outside the mask (little-endian) are not compared.
-    Mask(u32),
-    /// The same frame; the data as a value within ± the tolerance (timers).
-    Near(i64),
-}
-
-/// What one step does (README "Replay files", key `do`).
+/// What one step does (README "Replay files", key `do`): a step of the file's family.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Action {
-    /// Sends bytes and judges the answers of the device and the reference within the answer
-    /// window (manual 4.1 time-out, answer delay, slack).
-    Exchange {
-        /// Bytes on the line.
-        bytes: Vec<u8>,
-        /// How the answers are compared.
-        compare: Compare,
-        /// Silence from the device is accepted too.
-        silence_ok: bool,
-    },
-    /// Sends bytes without waiting (the first part of a split frame).
-    Send {
-        /// Bytes on the line.
-        bytes: Vec<u8>,
-    },
-    /// Listens for `us` µs and judges what comes (normally nothing).
-    Listen {
-        /// How long.
-        us: Micros,
-    },
-    /// Listens past the message time-out in force (manual 4, Pr26).
-    ListenTimeout,
-    /// Listens for half the message time-out in force.
-    ListenHalfTimeout,
-    /// Switches the device and the reference off and on (sim only).
-    PowerCycle,
-    /// Sets the digital inputs, bit i = input i (manual 3.8.1 b90; sim only).
-    Inputs {
-        /// The inputs.
-        value: u16,
-    },
-    /// Follows the bit rate the reference uses now (serial ports, after b42.3).
-    BitRate,
+    /// An HPD step (exchange, send, listen, power-cycle, inputs, bit-rate).
+    Hpd(HpdStep),
     /// A step of the cyclic-exchange protocol (PSD4xx, PSx3xx; README "Cyclic-exchange
     /// protocol").
     Cyclic(CyclicStep),
@@ -222,7 +179,7 @@ impl Action {
     /// The bytes the step puts on the line, if any (a record write: its data).
     pub fn bytes(&self) -> Option<&[u8]> {
         match self {
-            Action::Exchange { bytes, .. } | Action::Send { bytes } => Some(bytes),
+            Action::Hpd(h) => h.bytes(),
             Action::Cyclic(
                 CyclicStep::RecordWrite { data, .. } | CyclicStep::IsduWrite { data, .. },
             ) => Some(data),
@@ -233,16 +190,7 @@ impl Action {
     /// The same action with other bytes (exchanges, sends, record and ISDU writes).
     pub fn with_bytes(&self, new: Vec<u8>) -> Action {
         match self {
-            Action::Exchange {
-                compare,
-                silence_ok,
-                ..
-            } => Action::Exchange {
-                bytes: new,
-                compare: *compare,
-                silence_ok: *silence_ok,
-            },
-            Action::Send { .. } => Action::Send { bytes: new },
+            Action::Hpd(h) => Action::Hpd(h.with_bytes(new)),
             Action::Cyclic(CyclicStep::RecordWrite { index, .. }) => {
                 Action::Cyclic(CyclicStep::RecordWrite {
                     index: *index,
@@ -262,14 +210,7 @@ impl Action {
 
     fn name(&self) -> &'static str {
         match self {
-            Action::Exchange { .. } => "exchange",
-            Action::Send { .. } => "send",
-            Action::Listen { .. } => "listen",
-            Action::ListenTimeout => "listen-timeout",
-            Action::ListenHalfTimeout => "listen-half-timeout",
-            Action::PowerCycle => "power-cycle",
-            Action::Inputs { .. } => "inputs",
-            Action::BitRate => "bit-rate",
+            Action::Hpd(h) => h.name(),
             Action::Cyclic(c) => c.name(),
         }
     }
@@ -455,12 +396,24 @@ pub enum ReplayError {
         /// What is wrong (with the step index where it applies).
         why: String,
     },
+    /// A step of another family than the file's.
+    #[error("{file}: step {step}: `{action}` is not a {family} step")]
+    OtherFamily {
+        /// The file.
+        file: String,
+        /// Index of the step.
+        step: usize,
+        /// The step's name (key `do`).
+        action: String,
+        /// The file's family.
+        family: FamilyId,
+    },
 }
 
-/// The file form of [`Replay`].
+/// The file form of [`Replay`]; `S` is the form its steps are read or written in.
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct ReplayFile {
+struct ReplayFile<S> {
     format: String,
     family: FamilyId,
     dut: String,
@@ -473,12 +426,91 @@ struct ReplayFile {
     start: Start,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     finding: Option<FindingInfo>,
-    steps: Vec<StepFile>,
+    steps: Vec<S>,
     #[serde(default)]
     exchanges: Vec<Observed>,
 }
 
-/// The file form of [`Step`]: `do` names the action; the other keys are the action's.
+/// The file form of an HPD [`Step`]: the step's keys, then class, text and requirements.
+#[derive(Debug, Serialize, Deserialize)]
+struct HpdStepFile {
+    #[serde(flatten)]
+    step: HpdStep,
+    #[serde(default)]
+    class: String,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    text: String,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    requirements: Vec<String>,
+}
+
+impl HpdStepFile {
+    fn into_step(self) -> Step {
+        Step {
+            action: Action::Hpd(self.step),
+            class: self.class,
+            text: self.text,
+            requirements: self.requirements,
+        }
+    }
+}
+
+/// A step as written: in the form of its family.
+#[derive(Debug, Serialize)]
+#[serde(untagged)]
+enum StepOut {
+    Hpd(HpdStepFile),
+    Cyclic(StepFile),
+}
+
+impl StepOut {
+    fn of(s: &Step) -> StepOut {
+        match &s.action {
+            Action::Hpd(h) => StepOut::Hpd(HpdStepFile {
+                step: h.clone(),
+                class: s.class.clone(),
+                text: s.text.clone(),
+                requirements: s.requirements.clone(),
+            }),
+            Action::Cyclic(_) => StepOut::Cyclic(StepFile::of(s)),
+        }
+    }
+}
+
+/// Step `index` of a `family` file; a step that reads as one of another family is
+/// [`ReplayError::OtherFamily`].
+fn read_step(
+    family: FamilyId,
+    index: usize,
+    v: &serde_json::Value,
+    file: &str,
+) -> Result<Step, ReplayError> {
+    let hpd = HpdStepFile::deserialize(v)
+        .map(HpdStepFile::into_step)
+        .map_err(|e| format!("step {index}: {e}"));
+    let cyclic = StepFile::deserialize(v)
+        .map_err(|e| format!("step {index}: {e}"))
+        .and_then(|f| f.step(index));
+    let (own, other) = if family == FamilyId::Hpd {
+        (hpd, cyclic.ok())
+    } else {
+        (cyclic, hpd.ok())
+    };
+    own.map_err(|why| match other {
+        Some(s) => ReplayError::OtherFamily {
+            file: file.to_owned(),
+            step: index,
+            action: s.action.name().to_owned(),
+            family,
+        },
+        None => ReplayError::Format {
+            file: file.to_owned(),
+            why,
+        },
+    })
+}
+
+/// The file form of a cyclic [`Step`]: `do` names the action; the other keys are the action's.
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct StepFile {
@@ -487,13 +519,7 @@ struct StepFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     hex: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    compare: Option<Compare>,
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    silence_ok: bool,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     us: Option<Micros>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    value: Option<u16>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     control: Option<u16>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -538,10 +564,7 @@ impl StepFile {
         let mut f = StepFile {
             action: s.action.name().to_owned(),
             hex: s.action.bytes().map(to_hex),
-            compare: None,
-            silence_ok: false,
             us: None,
-            value: None,
             control: None,
             target: None,
             offset: None,
@@ -560,16 +583,6 @@ impl StepFile {
             requirements: s.requirements.clone(),
         };
         match &s.action {
-            Action::Exchange {
-                compare,
-                silence_ok,
-                ..
-            } => {
-                f.compare = Some(*compare);
-                f.silence_ok = *silence_ok;
-            }
-            Action::Listen { us } => f.us = Some(*us),
-            Action::Inputs { value } => f.value = Some(*value),
             Action::Cyclic(c) => match c {
                 CyclicStep::Process { control, target } => {
                     f.control = *control;
@@ -630,7 +643,8 @@ impl StepFile {
                     f.subindex = Some(*subindex);
                 }
             },
-            _ => {}
+            // HPD steps are written as [`HpdStepFile`].
+            Action::Hpd(_) => {}
         }
         f
     }
@@ -645,26 +659,6 @@ impl StepFile {
             parse_hex(hex).map_err(|e| format!("step {index}: hex: {e}"))
         };
         let action = match self.action.as_str() {
-            "exchange" => Action::Exchange {
-                bytes: bytes()?,
-                compare: self.compare.unwrap_or_default(),
-                silence_ok: self.silence_ok,
-            },
-            "send" => Action::Send { bytes: bytes()? },
-            "listen" => Action::Listen {
-                us: self
-                    .us
-                    .ok_or_else(|| format!("step {index}: `listen` needs `us`"))?,
-            },
-            "listen-timeout" => Action::ListenTimeout,
-            "listen-half-timeout" => Action::ListenHalfTimeout,
-            "power-cycle" => Action::PowerCycle,
-            "inputs" => Action::Inputs {
-                value: self
-                    .value
-                    .ok_or_else(|| format!("step {index}: `inputs` needs `value`"))?,
-            },
-            "bit-rate" => Action::BitRate,
             "process" => Action::Cyclic(CyclicStep::Process {
                 control: self.control,
                 target: self.target,
@@ -725,7 +719,7 @@ impl StepFile {
             }),
             other => {
                 return Err(format!(
-                    "step {index}: unknown action {other:?} (exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate; cyclic: hold, until, env, advance; psd4xx: process, offset, pkw, record-read, record-write; psx3xx: pd-out, isdu-read, isdu-write)"
+                    "step {index}: unknown action {other:?} (hpd: exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate; cyclic: hold, until, env, advance; psd4xx: process, offset, pkw, record-read, record-write; psx3xx: pd-out, isdu-read, isdu-write)"
                 ))
             }
         };
@@ -751,7 +745,7 @@ impl Replay {
             seed: self.seed,
             start: self.start,
             finding: self.finding.clone(),
-            steps: self.steps.iter().map(StepFile::of).collect(),
+            steps: self.steps.iter().map(StepOut::of).collect(),
             exchanges: self.exchanges.clone(),
         };
         serde_json::to_string_pretty(&file)
@@ -768,7 +762,8 @@ impl Replay {
             file: file.to_owned(),
             why,
         };
-        let f: ReplayFile = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+        let f: ReplayFile<serde_json::Value> =
+            serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
         if f.format != REPLAY_FORMAT {
             return Err(bad(format!(
                 "format {:?}, expected {REPLAY_FORMAT:?}",
@@ -777,23 +772,22 @@ impl Replay {
         }
         let steps = f
             .steps
-            .into_iter()
+            .iter()
             .enumerate()
-            .map(|(i, s)| s.step(i))
-            .collect::<Result<Vec<Step>, String>>()
-            .map_err(bad)?;
-        let cyclic = f.family != FamilyId::Hpd;
+            .map(|(i, v)| read_step(f.family, i, v, file))
+            .collect::<Result<Vec<Step>, ReplayError>>()?;
         // Cyclic steps of another family (PSD4xx records in a PSx3xx file) are refused too.
         let foreign = |a: &Action| match a {
-            Action::Cyclic(c) => !cyclic || c.family().is_some_and(|x| x != f.family),
-            _ => cyclic,
+            Action::Cyclic(c) => c.family().is_some_and(|x| x != f.family),
+            Action::Hpd(_) => false,
         };
         if let Some((i, s)) = steps.iter().enumerate().find(|(_, s)| foreign(&s.action)) {
-            return Err(bad(format!(
-                "step {i}: `{}` is not a {} step",
-                s.action.name(),
-                f.family
-            )));
+            return Err(ReplayError::OtherFamily {
+                file: file.to_owned(),
+                step: i,
+                action: s.action.name().to_owned(),
+                family: f.family,
+            });
         }
         if let Some(fi) = &f.finding {
             if fi.step >= steps.len() {
@@ -841,6 +835,7 @@ impl Replay {
 mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
+    use drivespec_hpd::step::Compare;
 
     fn sample() -> Replay {
         Replay {
@@ -854,37 +849,37 @@ mod tests {
             finding: None,
             steps: vec![
                 Step {
-                    action: Action::Send {
+                    action: Action::Hpd(HpdStep::Send {
                         bytes: vec![0x7E, 0x80],
-                    },
+                    }),
                     class: "split-timeout".into(),
                     text: "first part".into(),
                     requirements: vec![],
                 },
                 Step {
-                    action: Action::ListenTimeout,
+                    action: Action::Hpd(HpdStep::ListenTimeout {}),
                     class: "split-timeout".into(),
                     text: String::new(),
                     requirements: vec![],
                 },
                 Step {
-                    action: Action::Exchange {
+                    action: Action::Hpd(HpdStep::Exchange {
                         bytes: vec![0x02, 0xC6, 0x48],
                         compare: Compare::Mask(0xFF00),
                         silence_ok: false,
-                    },
+                    }),
                     class: "split-timeout".into(),
                     text: "rest".into(),
                     requirements: vec!["HPD-FRAME-020".into()],
                 },
                 Step {
-                    action: Action::Inputs { value: 5 },
+                    action: Action::Hpd(HpdStep::Inputs { value: 5 }),
                     class: "inputs".into(),
                     text: String::new(),
                     requirements: vec![],
                 },
                 Step {
-                    action: Action::Listen { us: 6144 },
+                    action: Action::Hpd(HpdStep::Listen { us: 6144 }),
                     class: "listen".into(),
                     text: String::new(),
                     requirements: vec![],
@@ -902,7 +897,7 @@ mod tests {
         let json = block.split("```").next().unwrap();
         let r = Replay::from_json(json, "README.md").unwrap();
         assert_eq!(r.steps.len(), 3);
-        assert_eq!(r.steps[1].action, Action::ListenTimeout);
+        assert_eq!(r.steps[1].action, Action::Hpd(HpdStep::ListenTimeout {}));
         assert_eq!(r.start, Start::Fresh);
     }
 
@@ -1052,5 +1047,32 @@ mod tests {
         let bad = text.replace(REPLAY_FORMAT, "drivespec-fuzz-replay/0");
         assert!(Replay::from_json(&bad, "x").is_err());
         assert!(Replay::from_json("{", "x").is_err());
+        // A misspelt key of an HPD step, and a key a step does not take, are refused.
+        let bad = text.replace("\"us\"", "\"uss\"");
+        let e = Replay::from_json(&bad, "x").unwrap_err().to_string();
+        assert!(e.contains("step 4") && e.contains("uss"), "{e}");
+        let bad = text.replace(
+            "\"do\": \"listen-timeout\"",
+            "\"do\": \"listen-timeout\", \"us\": 5",
+        );
+        assert!(Replay::from_json(&bad, "x").is_err());
+    }
+
+    #[test]
+    fn a_step_of_another_family_is_refused_by_name() {
+        let text = sample().to_json().replace(
+            "\"do\": \"listen-timeout\"",
+            "\"do\": \"pkw\", \"pkw\": { \"ak\": 1, \"pnu\": 3 }",
+        );
+        let e = Replay::from_json(&text, "x.json").unwrap_err();
+        assert!(
+            matches!(&e, ReplayError::OtherFamily { step: 1, action, family: FamilyId::Hpd, .. } if action == "pkw"),
+            "{e:?}"
+        );
+        assert_eq!(e.to_string(), "x.json: step 1: `pkw` is not a hpd step");
+        // And an HPD step in a cyclic file.
+        let text = sample().to_json().replace("\"hpd\"", "\"psd4xx\"");
+        let e = Replay::from_json(&text, "x.json").unwrap_err();
+        assert_eq!(e.to_string(), "x.json: step 0: `send` is not a psd4xx step");
     }
 }

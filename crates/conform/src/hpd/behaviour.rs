@@ -504,25 +504,14 @@ fn commands(g: &mut Gen) {
     g.stop_plc(&mut cb);
     g.write(&mut cb, Role::Setup, with_default, v2, "Pr2");
     g.bit(&mut cb, Role::Check, &defaults, true);
-    let msg = Message::ReadParam {
-        addr: own,
-        lun: with_default.size,
-        par: with_default.addr,
-    };
-    let b = g.bytes(&msg);
-    g.raw(
+    g.raw_read(
         &mut cb,
-        Role::Check,
-        b,
+        own,
+        with_default,
         "read Pr2: no answer, the line is disabled",
         &["HPD-BIT-40-14-DEFAULT", "HPD-BIT-40-14"],
     );
-    cb.action(
-        Role::Check,
-        Action::PowerCycle,
-        "switch the drive off and on",
-        &[],
-    );
+    cb.power_cycle();
     g.read(
         &mut cb,
         Role::Check,
@@ -542,25 +531,14 @@ fn commands(g: &mut Gen) {
             &["HPD-BIT-40-14"],
         );
         g.bit(&mut cb, Role::Check, &enable, false);
-        let msg = Message::ReadParam {
-            addr: own,
-            lun: scratch.size,
-            par: scratch.addr,
-        };
-        let b = g.bytes(&msg);
-        g.raw(
+        g.raw_read(
             &mut cb,
-            Role::Check,
-            b,
+            own,
+            scratch,
             "read Pr80: no answer",
             &["HPD-BIT-40-14"],
         );
-        cb.action(
-            Role::Check,
-            Action::PowerCycle,
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         g.read(&mut cb, Role::Check, scratch, Compare::Exact, "Pr80");
         g.push(cb);
     }
@@ -583,12 +561,7 @@ fn commands(g: &mut Gen) {
             later,
             "Pr80 (working value only)",
         );
-        cb.action(
-            Role::Check,
-            Action::PowerCycle,
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         g.read(&mut cb, Role::Check, scratch, Compare::Exact, "Pr80");
         g.restore(&mut cb, scratch, "Pr80");
         g.bit(&mut cb, Role::Cleanup, &save_ref, true);
@@ -606,12 +579,7 @@ fn commands(g: &mut Gen) {
             value,
             "Pr80 (working value only)",
         );
-        cb.action(
-            Role::Check,
-            Action::PowerCycle,
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         g.read(
             &mut cb,
             Role::Check,
@@ -635,12 +603,7 @@ fn commands(g: &mut Gen) {
         g.stop_plc(&mut cb);
         upload(g, &mut cb, Role::Setup, first, &program);
         g.bit(&mut cb, Role::Check, &save_ref, true);
-        cb.action(
-            Role::Check,
-            Action::PowerCycle,
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         read_plc(g, &mut cb, first, program.len());
         g.stop_plc(&mut cb);
         if let Some(s) = cb.steps.last_mut() {
@@ -658,12 +621,7 @@ fn commands(g: &mut Gen) {
         );
         g.stop_plc(&mut cb);
         upload(g, &mut cb, Role::Check, first, &program);
-        cb.action(
-            Role::Check,
-            Action::PowerCycle,
-            "switch the drive off and on",
-            &[],
-        );
+        cb.power_cycle();
         read_plc(g, &mut cb, first, program.len());
         g.push(cb);
     }
@@ -730,16 +688,10 @@ fn commands(g: &mut Gen) {
     g.write(&mut cb, Role::Setup, pr27, i64::from(other), "Pr27");
     g.bit(&mut cb, Role::Check, &reinit, true);
     g.read(&mut cb, Role::Check, ranged, Compare::Exact, "Pr33");
-    let msg = Message::ReadParam {
-        addr: other,
-        lun: ranged.size,
-        par: ranged.addr,
-    };
-    let b = g.bytes(&msg);
-    g.raw(
+    g.raw_read(
         &mut cb,
-        Role::Check,
-        b,
+        other,
+        ranged,
         format!("read Pr33 from drive {other}: no answer"),
         &["HPD-SERIAL-003"],
     );
@@ -753,16 +705,10 @@ fn commands(g: &mut Gen) {
         &["HPD-BIT-42-3", "HPD-PAR-038", "HPD-SERIAL-003", "HPD-SERIAL-009", "HPD-SERIAL-002"],
     );
     g.readdress(&mut cb, Role::Setup, own, other);
-    let msg = Message::ReadParam {
-        addr: own,
-        lun: ranged.size,
-        par: ranged.addr,
-    };
-    let b = g.bytes(&msg);
-    g.raw(
+    g.raw_read(
         &mut cb,
-        Role::Check,
-        b,
+        own,
+        ranged,
         format!("read Pr33 from drive {own}: no answer"),
         &["HPD-SERIAL-003"],
     );
@@ -903,22 +849,14 @@ fn baud(g: &mut Gen) {
         );
         cb.action(
             Role::Setup,
-            Action::BitRate,
+            Action::BitRate {},
             format!("switch the line to {} b/s", rate.bps),
             &[],
         );
         g.read(&mut cb, Role::Check, pr26, Compare::Exact, "Pr26");
-        cb.action(
-            Role::Check,
-            Action::Send {
-                bytes: head.clone(),
-            },
-            "send the first 3 bytes of a read of Pr33",
-            &[],
-        );
-        cb.action(
-            Role::Check,
-            Action::ListenTimeout,
+        cb.split_read(
+            &head,
+            Action::ListenTimeout {},
             format!("wait past the {} ms time-out", rate.timeout_ms),
             &["HPD-BAUD-002"],
         );
@@ -930,17 +868,9 @@ fn baud(g: &mut Gen) {
             &["HPD-BAUD-003", "HPD-FRAME-020"],
         );
         g.read(&mut cb, Role::Check, ranged, Compare::Exact, "Pr33");
-        cb.action(
-            Role::Check,
-            Action::Send {
-                bytes: head.clone(),
-            },
-            "send the first 3 bytes of a read of Pr33",
-            &[],
-        );
-        cb.action(
-            Role::Check,
-            Action::ListenHalfTimeout,
+        cb.split_read(
+            &head,
+            Action::ListenHalfTimeout {},
             format!("wait {} ms, half the time-out", rate.timeout_ms / 2),
             &["HPD-BAUD-002"],
         );
@@ -966,7 +896,12 @@ fn baud(g: &mut Gen) {
             i64::from(v42),
             "Pb42 (b42.3 = 1)",
         );
-        cb.action(Role::Cleanup, Action::BitRate, "switch the line back", &[]);
+        cb.action(
+            Role::Cleanup,
+            Action::BitRate {},
+            "switch the line back",
+            &[],
+        );
         g.restore(&mut cb, pb42, "Pb42");
         g.restore_pb99(&mut cb);
         g.push(cb);
@@ -1053,8 +988,8 @@ fn vectors(g: &mut Gen) {
                 bytes: request.clone(),
                 compare,
                 silence_ok: v.result == VectorResult::Acceptable,
-                golden,
             },
+            golden,
             text: format!("send {}", drivespec_spec::hex::to_hex(&request)),
             requirements: reqs,
         });

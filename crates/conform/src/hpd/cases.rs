@@ -64,15 +64,46 @@ impl CaseB {
         text: impl Into<String>,
         reqs: &[&str],
     ) {
-        if matches!(action, Action::PowerCycle) {
+        if matches!(action, Action::PowerCycle {}) {
             self.needs_power_cycle = true;
         }
         self.steps.push(Step {
             role,
             action,
+            golden: None,
             text: text.into(),
             requirements: reqs.iter().map(|r| (*r).to_owned()).collect(),
         });
+    }
+
+    /// Switches the drive off and on (a check step).
+    pub(crate) fn power_cycle(&mut self) {
+        self.action(
+            Role::Check,
+            Action::PowerCycle {},
+            "switch the drive off and on",
+            &[],
+        );
+    }
+
+    /// Sends `head`, the first 3 bytes of a read of Pr33, then pauses with `pause`
+    /// (manual 4.1: a message must be complete within the Pr26 time-out).
+    pub(crate) fn split_read(
+        &mut self,
+        head: &[u8],
+        pause: Action,
+        text: impl Into<String>,
+        reqs: &[&str],
+    ) {
+        self.action(
+            Role::Check,
+            Action::Send {
+                bytes: head.to_vec(),
+            },
+            "send the first 3 bytes of a read of Pr33",
+            &[],
+        );
+        self.action(Role::Check, pause, text, reqs);
     }
 }
 
@@ -103,6 +134,30 @@ pub(crate) struct BitRef<'s> {
     pub(crate) at: BitAddr,
 }
 
+/// Why the HPD cases or fuzz sequences cannot be generated from the spec.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum GenError {
+    /// The spec has no HPD protocol table.
+    #[error("no HPD protocol table")]
+    NoProtocol,
+    /// The framing rules cannot be read from the spec.
+    #[error(transparent)]
+    Rules(#[from] drivespec_hpd::RulesError),
+    /// The spec has no PLC tables (manual appendix G).
+    #[error("no PLC tables")]
+    NoPlc,
+    /// The protocol table's PLC run bit is not a bit of the spec.
+    #[error("PLC run bit {0:?} is not a bit of the spec")]
+    RunBit(String),
+    /// The reference drive cannot be built from the spec.
+    #[error(transparent)]
+    Model(#[from] drivespec_hpd::model::ModelError),
+    /// Cases that cannot be built (a message the spec's values do not encode).
+    #[error("{} problem(s) generating HPD cases, first: {}", .0.len(), .0.first().map_or("", String::as_str))]
+    Cases(Vec<String>),
+}
+
 impl<'s> Gen<'s> {
     pub(crate) fn new(
         spec: &'s Spec,
@@ -110,11 +165,11 @@ impl<'s> Gen<'s> {
         model: Option<&'s drivespec_spec::DeviceModel>,
         addr: u8,
         seed: u64,
-    ) -> Result<Gen<'s>, String> {
+    ) -> Result<Gen<'s>, GenError> {
         let family = spec.family(FamilyId::Hpd);
-        let protocol = family.hpd().ok_or("no HPD protocol table")?;
-        let rules = FrameRules::from_spec(spec).map_err(|e| e.to_string())?;
-        let codec = PlcCodec::from_spec(spec).ok_or("no PLC tables")?;
+        let protocol = family.hpd().ok_or(GenError::NoProtocol)?;
+        let rules = FrameRules::from_spec(spec)?;
+        let codec = PlcCodec::from_spec(spec).ok_or(GenError::NoPlc)?;
         let map = ParamMap::from_spec(spec);
         let mut g = Gen {
             family,
@@ -130,7 +185,9 @@ impl<'s> Gen<'s> {
             errors: Vec::new(),
             run: (Slot { addr: 0, size: 0 }, BitAddr { byte: 0, mask: 0 }),
         };
-        let run = g.bit_ref(&protocol.plc.run_bit).ok_or("no PLC run bit")?;
+        let run = g
+            .bit_ref(&protocol.plc.run_bit)
+            .ok_or_else(|| GenError::RunBit(protocol.plc.run_bit.clone()))?;
         g.run = (run.slot, run.at);
         Ok(g)
     }
@@ -189,6 +246,15 @@ impl<'s> Gen<'s> {
             }
         }
         self.family.resolve(p, self.model).range
+    }
+
+    /// The operating modes in which `p` has a range of its own (manual 3.6).
+    pub(crate) fn ranged_modes(p: &Parameter) -> Vec<u32> {
+        p.modes
+            .iter()
+            .filter(|m| m.range.is_some())
+            .flat_map(|m| m.modes.iter().copied())
+            .collect()
     }
 
     /// The requirement IDs in the spec (so cases never cite a missing one).
@@ -294,8 +360,8 @@ impl<'s> Gen<'s> {
                 bytes,
                 compare,
                 silence_ok: false,
-                golden: None,
             },
+            golden: None,
             text: text.into(),
             requirements: reqs.iter().map(|s| (*s).to_owned()).collect(),
         });
@@ -327,11 +393,30 @@ impl<'s> Gen<'s> {
                 bytes,
                 compare: Compare::Exact,
                 silence_ok: false,
-                golden: None,
             },
+            golden: None,
             text: text.into(),
             requirements: reqs.iter().map(|s| (*s).to_owned()).collect(),
         });
+    }
+
+    /// A read of `slot` addressed to drive `addr`, as raw bytes with the requirements given
+    /// (a read the drive must not answer).
+    pub(crate) fn raw_read(
+        &mut self,
+        cb: &mut CaseB,
+        addr: u8,
+        slot: Slot,
+        text: impl Into<String>,
+        reqs: &[&str],
+    ) {
+        let msg = Message::ReadParam {
+            addr,
+            lun: slot.size,
+            par: slot.addr,
+        };
+        let bytes = self.bytes(&msg);
+        self.raw(cb, Role::Check, bytes, text, reqs);
     }
 
     fn touch(&self, cb: &mut CaseB, par: u8, len: u8) {
@@ -466,7 +551,7 @@ impl<'s> Gen<'s> {
         let is_timer = self.protocol.plc.timers.iter().any(|t| t.param == p.id);
         if is_timer {
             // Timers count down every scan (manual 3.8.1): ± 64 scans (about 0.4 s).
-            return Compare::Near { tolerance: 64 };
+            return Compare::Near(64);
         }
         if !p.live {
             return Compare::Exact;
@@ -639,4 +724,28 @@ pub(crate) fn sign_for(slot: Slot, raw: u32, family: &Family) -> i64 {
 pub(crate) fn bit_value(slot: Slot, at: BitAddr) -> u32 {
     let shift = 8 * u32::from(at.byte.saturating_sub(slot.addr));
     u32::from(at.mask).checked_shl(shift).unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::suite::SetupError;
+
+    #[test]
+    fn generation_errors_name_what_is_missing() {
+        let e = GenError::Cases(vec!["first".into(), "second".into()]);
+        assert_eq!(
+            e.to_string(),
+            "2 problem(s) generating HPD cases, first: first"
+        );
+        let e = SetupError::from(GenError::RunBit("b99.x".into()));
+        assert_eq!(
+            e.to_string(),
+            "spec: PLC run bit \"b99.x\" is not a bit of the spec"
+        );
+        assert_eq!(
+            SetupError::from(GenError::NoProtocol).to_string(),
+            "spec: no HPD protocol table"
+        );
+    }
 }

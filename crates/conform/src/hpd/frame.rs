@@ -61,6 +61,12 @@ fn still_answers(g: &mut Gen, cb: &mut CaseB, slot: Slot) {
     );
 }
 
+/// Pr80 is read back unchanged, then restored.
+fn unchanged(g: &mut Gen, cb: &mut CaseB, scratch: Slot) {
+    g.read(cb, Role::Check, scratch, Compare::Exact, "Pr80 (unchanged)");
+    g.restore(cb, scratch, "Pr80");
+}
+
 fn message_types(
     g: &mut Gen,
     ranged: Slot,
@@ -359,14 +365,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
             &["HPD-SERIAL-012", "HPD-FRAME-009"],
         );
         if writes {
-            g.read(
-                &mut cb,
-                Role::Check,
-                scratch,
-                Compare::Exact,
-                "Pr80 (unchanged)",
-            );
-            g.restore(&mut cb, scratch, "Pr80");
+            unchanged(g, &mut cb, scratch);
         } else {
             still_answers(g, &mut cb, ranged);
         }
@@ -382,14 +381,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
         let bytes = frame(g, &fields, None);
         g.raw(&mut cb, Role::Check, bytes, text.to_owned(), reqs);
         if check == scratch {
-            g.read(
-                &mut cb,
-                Role::Check,
-                scratch,
-                Compare::Exact,
-                "Pr80 (unchanged)",
-            );
-            g.restore(&mut cb, scratch, "Pr80");
+            unchanged(g, &mut cb, scratch);
         } else {
             still_answers(g, &mut cb, ranged);
         }
@@ -493,14 +485,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
         "send Pr80 = $7E without stuffing",
         &["HPD-FRAME-003", "HPD-SERIAL-012"],
     );
-    g.read(
-        &mut cb,
-        Role::Check,
-        scratch,
-        Compare::Exact,
-        "Pr80 (unchanged)",
-    );
-    g.restore(&mut cb, scratch, "Pr80");
+    unchanged(g, &mut cb, scratch);
     g.push(cb);
 
     let wrong = {
@@ -520,14 +505,7 @@ fn corrupt(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
         "send $7E $01 inside a write",
         &["HPD-FRAME-004", "HPD-SERIAL-012"],
     );
-    g.read(
-        &mut cb,
-        Role::Check,
-        scratch,
-        Compare::Exact,
-        "Pr80 (unchanged)",
-    );
-    g.restore(&mut cb, scratch, "Pr80");
+    unchanged(g, &mut cb, scratch);
     g.push(cb);
 }
 
@@ -540,17 +518,9 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
         "a read that stops after 3 bytes gets no answer; after the time-out the next read is answered",
         &["HPD-BAUD-003", "HPD-FRAME-020"],
     );
-    cb.action(
-        Role::Check,
-        Action::Send {
-            bytes: head.clone(),
-        },
-        "send the first 3 bytes of a read of Pr33",
-        &[],
-    );
-    cb.action(
-        Role::Check,
-        Action::ListenTimeout,
+    cb.split_read(
+        &head,
+        Action::ListenTimeout {},
         "listen past the message time-out (no answer)",
         &["HPD-FRAME-020"],
     );
@@ -562,17 +532,9 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
         "a read split by a pause longer than the Pr26 time-out is dropped: no answer to either part",
         &["HPD-BAUD-002", "HPD-BAUD-003", "HPD-FRAME-020"],
     );
-    cb.action(
-        Role::Check,
-        Action::Send {
-            bytes: head.clone(),
-        },
-        "send the first 3 bytes of a read of Pr33",
-        &[],
-    );
-    cb.action(
-        Role::Check,
-        Action::ListenTimeout,
+    cb.split_read(
+        &head,
+        Action::ListenTimeout {},
         "wait past the message time-out",
         &["HPD-BAUD-002"],
     );
@@ -591,15 +553,9 @@ fn timing(g: &mut Gen, ranged: Slot, read: &[u8]) {
         "a read split by a pause of half the time-out is complete in time and answered",
         &["HPD-BAUD-002", "HPD-FRAME-020"],
     );
-    cb.action(
-        Role::Check,
-        Action::Send { bytes: head },
-        "send the first 3 bytes of a read of Pr33",
-        &[],
-    );
-    cb.action(
-        Role::Check,
-        Action::ListenHalfTimeout,
+    cb.split_read(
+        &head,
+        Action::ListenHalfTimeout {},
         "wait half the message time-out",
         &["HPD-BAUD-002"],
     );
@@ -698,16 +654,10 @@ fn foreign(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
             format!("a read addressed to drive {other} gets no answer from drive {own}"),
             &["HPD-SERIAL-003", "HPD-SERIAL-002"],
         );
-        let msg = Message::ReadParam {
-            addr: other,
-            lun: ranged.size,
-            par: ranged.addr,
-        };
-        let b = g.bytes(&msg);
-        g.raw(
+        g.raw_read(
             &mut cb,
-            Role::Check,
-            b,
+            other,
+            ranged,
             format!("read Pr33 from drive {other}"),
             &["HPD-SERIAL-003"],
         );
@@ -734,13 +684,6 @@ fn foreign(g: &mut Gen, ranged: Slot, scratch: Slot, value: i64) {
             &["HPD-SERIAL-003"],
         );
     }
-    g.read(
-        &mut cb,
-        Role::Check,
-        scratch,
-        Compare::Exact,
-        "Pr80 (unchanged)",
-    );
-    g.restore(&mut cb, scratch, "Pr80");
+    unchanged(g, &mut cb, scratch);
     g.push(cb);
 }

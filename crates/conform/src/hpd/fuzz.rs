@@ -10,9 +10,9 @@ mod sequences;
 
 use crate::case::{CaseInfo, CaseRun, Failure, Outcome, RequirementRef, Role};
 use crate::fuzz::engine::{self, Fault, Target, Trial};
-use crate::fuzz::replay::{Action, Compare, FindingClass, Start, Step};
-use crate::hpd::step::{Action as HAction, Compare as HCompare, HpdCase, Step as HStep};
-use crate::hpd::{HpdSession, HpdSuite};
+use crate::fuzz::replay::{Action, FindingClass, Start, Step};
+use crate::hpd::step::{Action as HAction, HpdCase, Step as HStep};
+use crate::hpd::{GenError, HpdSession, HpdSuite};
 use crate::link::{Caps, Link, LinkError, Recovered};
 use crate::rng::Rng;
 use crate::suite::SetupError;
@@ -44,9 +44,8 @@ impl<'a, 's> HpdTarget<'a, 's> {
         link: Box<dyn Link>,
     ) -> Result<HpdTarget<'a, 's>, SetupError> {
         let caps = link.caps();
-        let rules =
-            FrameRules::from_spec(suite.spec()).map_err(|e| SetupError::Spec(e.to_string()))?;
-        let mut gen = HpdGen::new(suite, caps).map_err(SetupError::Spec)?;
+        let rules = FrameRules::from_spec(suite.spec()).map_err(GenError::from)?;
+        let mut gen = HpdGen::new(suite, caps)?;
         let probe = gen.probe();
         Ok(HpdTarget {
             family: suite.family(),
@@ -75,7 +74,9 @@ impl<'a, 's> HpdTarget<'a, 's> {
             steps: steps.iter().map(|s| s.text.clone()).collect(),
         };
         let case = HpdCase {
-            needs_power_cycle: steps.iter().any(|s| s.action == Action::PowerCycle),
+            needs_power_cycle: steps
+                .iter()
+                .any(|s| s.action == Action::Hpd(HAction::PowerCycle {})),
             touched: self.touched(steps),
             steps: hsteps,
         };
@@ -129,19 +130,16 @@ impl<'a, 's> HpdTarget<'a, 's> {
     /// What kind of message a step sends, for signatures.
     fn kind(&self, s: Option<&Step>) -> String {
         match s.map(|s| &s.action) {
-            Some(Action::Exchange { bytes, .. }) => {
+            Some(Action::Hpd(HAction::Exchange { bytes, .. })) => {
                 match drivespec_hpd::parse(&self.rules, bytes) {
                     Ok(m) => m.kind().spec_name().to_owned(),
                     Err(_) => "malformed".to_owned(),
                 }
             }
-            Some(Action::Send { .. }) => "send".to_owned(),
-            Some(Action::Listen { .. } | Action::ListenTimeout | Action::ListenHalfTimeout) => {
-                "listen".to_owned()
-            }
-            Some(Action::PowerCycle) => "power-cycle".to_owned(),
-            Some(Action::Inputs { .. }) => "inputs".to_owned(),
-            Some(Action::BitRate) => "bit-rate".to_owned(),
+            Some(Action::Hpd(
+                HAction::Listen { .. } | HAction::ListenTimeout {} | HAction::ListenHalfTimeout {},
+            )) => "listen".to_owned(),
+            Some(Action::Hpd(h)) => h.name().to_owned(),
             Some(Action::Cyclic(_)) => "cyclic".to_owned(),
             None => "start".to_owned(),
         }
@@ -184,35 +182,13 @@ impl NotHpdStep {
 
 /// A fuzz step as a conformance step (judged); None for a step of another family.
 fn to_hpd(s: &Step) -> Option<HStep> {
-    let action = match &s.action {
-        Action::Exchange {
-            bytes,
-            compare,
-            silence_ok,
-        } => HAction::Exchange {
-            bytes: bytes.clone(),
-            compare: match compare {
-                Compare::Exact => HCompare::Exact,
-                Compare::Mask(m) => HCompare::Mask(*m),
-                Compare::Near(t) => HCompare::Near { tolerance: *t },
-            },
-            silence_ok: *silence_ok,
-            golden: None,
-        },
-        Action::Send { bytes } => HAction::Send {
-            bytes: bytes.clone(),
-        },
-        Action::Listen { us } => HAction::Listen { us: *us },
-        Action::ListenTimeout => HAction::ListenTimeout,
-        Action::ListenHalfTimeout => HAction::ListenHalfTimeout,
-        Action::PowerCycle => HAction::PowerCycle,
-        Action::Inputs { value } => HAction::Inputs { value: *value },
-        Action::BitRate => HAction::BitRate,
-        Action::Cyclic(_) => return None,
+    let Action::Hpd(action) = &s.action else {
+        return None;
     };
     Some(HStep {
         role: Role::Check,
-        action,
+        action: action.clone(),
+        golden: None,
         text: s.text.clone(),
         requirements: s.requirements.clone(),
     })
@@ -376,7 +352,7 @@ mod tests {
 
     #[test]
     fn a_cyclic_step_is_not_an_hpd_step() {
-        assert!(to_hpd(&step(Action::Listen { us: 5 })).is_some());
+        assert!(to_hpd(&step(Action::Hpd(HAction::Listen { us: 5 }))).is_some());
         let cyclic = step(Action::Cyclic(CyclicStep::Hold { cycles: 1 }));
         assert_eq!(to_hpd(&cyclic), None);
         let e = NotHpdStep::new(3, &cyclic);

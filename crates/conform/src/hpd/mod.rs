@@ -24,6 +24,7 @@ mod params;
 mod session;
 pub(crate) mod step;
 
+pub use cases::GenError;
 pub use session::HpdSession;
 
 use crate::case::CaseInfo;
@@ -56,9 +57,7 @@ impl<'s> HpdSuite<'s> {
     /// with the Pr26 code of `settings.bit_rate` (default: Pr26's delivery value).
     pub fn new(spec: &'s Spec, settings: &Settings) -> Result<HpdSuite<'s>, SetupError> {
         let family = spec.family(FamilyId::Hpd);
-        let protocol = family
-            .hpd()
-            .ok_or_else(|| SetupError::Spec("no HPD protocol table".to_owned()))?;
+        let protocol = family.hpd().ok_or(GenError::NoProtocol)?;
         let model = match &settings.model {
             Some(m) => Some(family.model(m).ok_or_else(|| {
                 let known: Vec<&str> = family.models.iter().map(|m| m.id.as_str()).collect();
@@ -101,23 +100,19 @@ impl<'s> HpdSuite<'s> {
             Some(c) => DriveConfig::commissioned_at(c, settings.address),
             None => DriveConfig::commissioned(settings.address),
         };
-        let baseline = Drive::new(spec, config).map_err(|e| SetupError::Spec(e.to_string()))?;
+        let baseline = Drive::new(spec, config).map_err(GenError::from)?;
         let mut g = cases::Gen::new(
             spec,
             baseline.clone(),
             model,
             settings.address,
             settings.seed,
-        )
-        .map_err(SetupError::Spec)?;
+        )?;
         frame::generate(&mut g);
         params::generate(&mut g);
         behaviour::generate(&mut g);
-        if let Some(first) = g.errors.first() {
-            return Err(SetupError::Spec(format!(
-                "{} problem(s) generating HPD cases, first: {first}",
-                g.errors.len()
-            )));
+        if !g.errors.is_empty() {
+            return Err(GenError::Cases(g.errors).into());
         }
         let rules = g.rules.clone();
         let codec = g.codec.clone();

@@ -60,12 +60,7 @@ fn param_cases(g: &mut Gen, p: &Parameter) {
         return;
     }
     edges(g, p, slot, None);
-    let modes: Vec<u32> = p
-        .modes
-        .iter()
-        .filter(|m| m.range.is_some())
-        .flat_map(|m| m.modes.iter().copied())
-        .collect();
+    let modes = Gen::ranged_modes(p);
     for m in modes {
         edges(g, p, slot, Some(m));
     }

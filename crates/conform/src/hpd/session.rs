@@ -314,7 +314,7 @@ fn matches(rules: &drivespec_hpd::FrameRules, compare: Compare, exp: &[u8], got:
     if exp == got {
         return true;
     }
-    let (Compare::Mask(_) | Compare::Near { .. }) = compare else {
+    let (Compare::Mask(_) | Compare::Near(_)) = compare else {
         return false;
     };
     let (Ok(a), Ok(b)) = (
@@ -337,7 +337,7 @@ fn matches(rules: &drivespec_hpd::FrameRules, compare: Compare, exp: &[u8], got:
             },
         ) if aa == ba && ap == bp && ad.len() == bd.len() => match compare {
             Compare::Mask(m) => ad.unsigned() & m == bd.unsigned() & m,
-            Compare::Near { tolerance } => {
+            Compare::Near(tolerance) => {
                 (i64::from(ad.unsigned()) - i64::from(bd.unsigned())).abs() <= tolerance
             }
             Compare::Exact => false,
@@ -486,8 +486,8 @@ impl HpdSession<'_, '_> {
                     bytes,
                     compare,
                     silence_ok,
-                    golden,
                 } => {
+                    let golden = &step.golden;
                     let request = drivespec_hpd::parse(&suite.rules, bytes).ok();
                     rec.sent = Some(to_hex(bytes));
                     rec.sent_text = Some(self.words(bytes, None));
@@ -523,7 +523,7 @@ impl HpdSession<'_, '_> {
                             rec.note = match compare {
                                 Compare::Exact => None,
                                 Compare::Mask(m) => Some(format!("data compared under mask {m:#06x} (bits the drive sets itself are not compared)")),
-                                Compare::Near { tolerance } => Some(format!("data compared within ±{tolerance}")),
+                                Compare::Near(tolerance) => Some(format!("data compared within ±{tolerance}")),
                             };
                             if *silence_ok {
                                 rec.note = Some(
@@ -559,11 +559,11 @@ impl HpdSession<'_, '_> {
                         Err(e) => Err((e, Vec::new())),
                     }
                 }
-                Action::Listen { .. } | Action::ListenTimeout | Action::ListenHalfTimeout => {
+                Action::Listen { .. } | Action::ListenTimeout {} | Action::ListenHalfTimeout {} => {
                     let (timeout, _, _) = self.line_times();
                     let us = match step.action {
                         Action::Listen { us } => us,
-                        Action::ListenTimeout => timeout + self.slack.max(1_000),
+                        Action::ListenTimeout {} => timeout + self.slack.max(1_000),
                         _ => timeout / 2,
                     };
                     rec.note = Some(format!("listened {us} µs"));
@@ -584,7 +584,7 @@ impl HpdSession<'_, '_> {
                         Err(e) => Err(e),
                     }
                 }
-                Action::PowerCycle => match self.link.power_cycle() {
+                Action::PowerCycle {} => match self.link.power_cycle() {
                     Ok(_) => {
                         let t = self.link.now();
                         let o = self.oracle_now(t);
@@ -594,7 +594,7 @@ impl HpdSession<'_, '_> {
                     }
                     Err(e) => Err((e, Vec::new())),
                 },
-                Action::BitRate => {
+                Action::BitRate {} => {
                     let bps = self.oracle.line().map_or(0, |l| l.bps);
                     rec.note = Some(format!("{bps} b/s"));
                     match self.link.set_bit_rate(bps) {

@@ -9,11 +9,11 @@
 
 use crate::case::Role;
 use crate::fuzz::engine::{below, chance, pick};
-use crate::fuzz::replay::{Action, Compare, Step};
-use crate::hpd::cases::{BitRef, CaseB, Gen};
+use crate::fuzz::replay::{self, Step};
+use crate::hpd::cases::{BitRef, CaseB, Gen, GenError};
 use crate::hpd::frame::frame;
 use crate::hpd::names;
-use crate::hpd::step::{Action as HAction, Compare as HCompare, Step as HStep};
+use crate::hpd::step::{Action, Compare, Step as SuiteStep};
 use crate::hpd::HpdSuite;
 use crate::link::{Caps, Micros};
 use crate::rng::Rng;
@@ -135,7 +135,7 @@ fn parse_bit(name: &str) -> Option<(u8, u8)> {
 
 impl<'a, 's> HpdGen<'a, 's> {
     /// A generator for the device the suite was made for, on a transport with `caps`.
-    pub(crate) fn new(suite: &'a HpdSuite<'s>, caps: Caps) -> Result<HpdGen<'a, 's>, String> {
+    pub(crate) fn new(suite: &'a HpdSuite<'s>, caps: Caps) -> Result<HpdGen<'a, 's>, GenError> {
         let spec = suite.spec();
         let family = suite.family();
         let model = suite.model_id().and_then(|m| family.model(m));
@@ -256,7 +256,8 @@ impl<'a, 's> HpdGen<'a, 's> {
             }
             i += 1;
         }
-        let run_bit = parse_bit(&protocol.plc.run_bit).ok_or("PLC run bit not a bit")?;
+        let run_bit = parse_bit(&protocol.plc.run_bit)
+            .ok_or_else(|| GenError::RunBit(protocol.plc.run_bit.clone()))?;
         let dword_bit = g.bit_ref(&arith.dword_force_bit);
         let inputs = u32::try_from(protocol.io.inputs.len()).unwrap_or(8).min(16);
         let scan_us = Micros::from(protocol.plc.scan_us);
@@ -297,39 +298,20 @@ impl<'a, 's> HpdGen<'a, 's> {
 
     // ---------------------------------------------------------------- building steps
 
-    fn conv(&self, s: HStep, class: &str) -> Step {
-        let exact = self.exact;
-        let cmp = |c: HCompare| {
-            if exact {
-                return Compare::Exact;
-            }
-            match c {
-                HCompare::Exact => Compare::Exact,
-                HCompare::Mask(m) => Compare::Mask(m),
-                HCompare::Near { tolerance } => Compare::Near(tolerance),
-            }
-        };
+    /// A suite step as a fuzz step of `class`; with `exact`, every exchange compares exactly.
+    fn conv(&self, s: SuiteStep, class: &str) -> Step {
         let action = match s.action {
-            HAction::Exchange {
+            Action::Exchange {
+                bytes, silence_ok, ..
+            } if self.exact => Action::Exchange {
                 bytes,
-                compare,
-                silence_ok,
-                ..
-            } => Action::Exchange {
-                bytes,
-                compare: cmp(compare),
+                compare: Compare::Exact,
                 silence_ok,
             },
-            HAction::Send { bytes } => Action::Send { bytes },
-            HAction::Listen { us } => Action::Listen { us },
-            HAction::ListenTimeout => Action::ListenTimeout,
-            HAction::ListenHalfTimeout => Action::ListenHalfTimeout,
-            HAction::PowerCycle => Action::PowerCycle,
-            HAction::BitRate => Action::BitRate,
-            HAction::Inputs { value } => Action::Inputs { value },
+            other => other,
         };
         Step {
-            action,
+            action: replay::Action::Hpd(action),
             class: class.to_owned(),
             text: s.text,
             requirements: s.requirements,
@@ -343,7 +325,7 @@ impl<'a, 's> HpdGen<'a, 's> {
         self.g.errors.clear();
     }
 
-    fn msg(&mut self, out: &mut Vec<Step>, class: &str, m: Message, cmp: HCompare, text: String) {
+    fn msg(&mut self, out: &mut Vec<Step>, class: &str, m: Message, cmp: Compare, text: String) {
         let mut cb = CaseB::new("hpd/fuzz", "", &[]);
         self.g.msg(&mut cb, Role::Check, m, cmp, text);
         self.take(out, cb, class);
@@ -367,7 +349,7 @@ impl<'a, 's> HpdGen<'a, 's> {
 
     fn step(&self, out: &mut Vec<Step>, class: &str, action: Action, text: String, reqs: &[&str]) {
         out.push(Step {
-            action,
+            action: replay::Action::Hpd(action),
             class: class.to_owned(),
             text,
             requirements: reqs.iter().map(|r| (*r).to_owned()).collect(),
@@ -413,7 +395,7 @@ impl<'a, 's> HpdGen<'a, 's> {
         out
     }
 
-    fn compare_of(&self, slot: Slot) -> HCompare {
+    fn compare_of(&self, slot: Slot) -> Compare {
         match self.g.family.parameter_at_address(u32::from(slot.addr)) {
             Some(p)
                 if p.address == Some(u32::from(slot.addr))
@@ -421,7 +403,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             {
                 self.g.compare_for(p, None)
             }
-            _ => HCompare::Exact,
+            _ => Compare::Exact,
         }
     }
 
@@ -446,7 +428,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 out,
                 class,
                 m,
-                HCompare::Exact,
+                Compare::Exact,
                 format!("write {what} = {value}"),
             );
         }
@@ -666,7 +648,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 self.step(
                     out,
                     "power-cycle",
-                    Action::PowerCycle,
+                    Action::PowerCycle {},
                     "switch the drive off and on".to_owned(),
                     &["HPD-PAR-018"],
                 );
@@ -762,7 +744,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 out,
                 "odd-read",
                 m,
-                HCompare::Exact,
+                Compare::Exact,
                 format!("read {lun} byte(s) at {par:#04x}"),
             );
         }
@@ -794,12 +776,7 @@ impl<'a, 's> HpdGen<'a, 's> {
         let Some((p, s)) = pick(rng, &self.moded).copied() else {
             return;
         };
-        let modes: Vec<u32> = p
-            .modes
-            .iter()
-            .filter(|m| m.range.is_some())
-            .flat_map(|m| m.modes.iter().copied())
-            .collect();
+        let modes = Gen::ranged_modes(p);
         let (Some(&mode), Some(ms)) = (pick(rng, &modes), self.g.slot_of(names::OPERATING_MODE))
         else {
             return;
@@ -867,7 +844,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             value: rng.byte(),
         };
         let text = format!("bit change on byte {off} of {}", p.id);
-        self.msg(out, "bit-change-raw", m, HCompare::Exact, text);
+        self.msg(out, "bit-change-raw", m, Compare::Exact, text);
         self.read_slot(out, "valid-read", s, &p.id);
     }
 
@@ -946,7 +923,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "broadcast",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("broadcast {what} = {v}"),
         );
         if chance(rng, 80) {
@@ -1140,7 +1117,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             self.step(
                 out,
                 "truncated",
-                Action::ListenTimeout,
+                Action::ListenTimeout {},
                 "listen past the message time-out".to_owned(),
                 &["HPD-FRAME-020", "HPD-BAUD-003"],
             );
@@ -1266,13 +1243,13 @@ impl<'a, 's> HpdGen<'a, 's> {
         let (class, pause, text, reqs): (&str, Action, &str, &[&str]) = match rng.range(0, 2) {
             0 => (
                 "split-timeout",
-                Action::ListenTimeout,
+                Action::ListenTimeout {},
                 "wait past the message time-out",
                 &["HPD-BAUD-002", "HPD-BAUD-003", "HPD-FRAME-020"],
             ),
             1 => (
                 "split-within",
-                Action::ListenHalfTimeout,
+                Action::ListenHalfTimeout {},
                 "wait half the message time-out",
                 &["HPD-BAUD-002", "HPD-FRAME-020"],
             ),
@@ -1329,7 +1306,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             self.step(
                 out,
                 "noise",
-                Action::ListenTimeout,
+                Action::ListenTimeout {},
                 "let the noise time out".to_owned(),
                 &["HPD-FRAME-020"],
             );
@@ -1374,7 +1351,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "plc-read",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("read {lun} PLC byte(s) at {par:#04x}"),
         );
     }
@@ -1639,7 +1616,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                 out,
                 c,
                 m,
-                HCompare::Exact,
+                Compare::Exact,
                 format!("write {n} PLC byte(s) at {par:#04x}"),
             );
         }
@@ -1741,7 +1718,7 @@ impl<'a, 's> HpdGen<'a, 's> {
                     out,
                     "plc-read",
                     m,
-                    HCompare::Exact,
+                    Compare::Exact,
                     format!("read back PLC bytes at {at:#04x}"),
                 );
                 at += lun;
@@ -1770,7 +1747,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "plc-write-running",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("write an instruction at {at:#04x} (PLC as it is)"),
         );
         let lun = data.len();
@@ -1783,7 +1760,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             out,
             "plc-read",
             m,
-            HCompare::Exact,
+            Compare::Exact,
             format!("read PLC bytes at {at:#04x}"),
         );
     }

@@ -1,0 +1,221 @@
+//! The HPD step language: what a master puts on the line, how long it listens, what it does
+//! to the drive's supply and inputs, and how an answer is compared with the reference
+//! model's (manual chapter 4; fuzz replay files, `crates/conform/README.md` "Replay files").
+//!
+//! A step reads and writes as one record whose key `do` names it
+//! (`{"do": "exchange", "hex": "02 C6 48", "compare": "exact"}`); every step is
+//! `deny_unknown_fields`, so a misspelt key is an error naming the key.
+
+use crate::line::Micros;
+use serde::{Deserialize, Serialize};
+
+/// How an answer of the device is compared with the reference model's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Compare {
+    /// Byte for byte, silence included.
+    #[default]
+    Exact,
+    /// The same frames; data bits outside the mask (little-endian over the data bytes) are
+    /// not compared (values the drive changes by itself, manual 3.3 "live").
+    Mask(u32),
+    /// The same frame header; the data as a value within ± the tolerance (timers counting).
+    Near(i64),
+}
+
+/// One HPD step (key `do`). Steps without keys are written `Name {}` so that a key given
+/// to them is refused too.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "do", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Step {
+    /// Sends bytes and compares what the device and the reference send back within the
+    /// answer window (manual 4.1: the Pr26 time-out in force, any answer delay, and slack).
+    Exchange {
+        /// Bytes on the line (key `hex`).
+        #[serde(rename = "hex", with = "hex_text")]
+        bytes: Vec<u8>,
+        /// How the answers are compared.
+        #[serde(default)]
+        compare: Compare,
+        /// Silence from the device is accepted too (a vector whose result is `acceptable`).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        silence_ok: bool,
+    },
+    /// Sends bytes without waiting (the first part of a split frame).
+    Send {
+        /// Bytes on the line (key `hex`).
+        #[serde(rename = "hex", with = "hex_text")]
+        bytes: Vec<u8>,
+    },
+    /// Listens for `us` µs and compares what comes (normally nothing).
+    Listen {
+        /// How long.
+        us: Micros,
+    },
+    /// Listens past the message time-out in force plus slack (manual 4, Pr26).
+    ListenTimeout {},
+    /// Listens for half the message time-out in force.
+    ListenHalfTimeout {},
+    /// Switches the device and the reference off and on.
+    PowerCycle {},
+    /// Sets the digital inputs of the device and the reference, bit i = input i (manual
+    /// 3.8.1 b90).
+    Inputs {
+        /// The inputs.
+        value: u16,
+    },
+    /// Sets the transport's bit rate to the one the reference now uses (after b42.3).
+    BitRate {},
+}
+
+impl Step {
+    /// The step's name (its `do` key).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Step::Exchange { .. } => "exchange",
+            Step::Send { .. } => "send",
+            Step::Listen { .. } => "listen",
+            Step::ListenTimeout {} => "listen-timeout",
+            Step::ListenHalfTimeout {} => "listen-half-timeout",
+            Step::PowerCycle {} => "power-cycle",
+            Step::Inputs { .. } => "inputs",
+            Step::BitRate {} => "bit-rate",
+        }
+    }
+
+    /// The bytes the step puts on the line, if any.
+    pub fn bytes(&self) -> Option<&[u8]> {
+        match self {
+            Step::Exchange { bytes, .. } | Step::Send { bytes } => Some(bytes),
+            _ => None,
+        }
+    }
+
+    /// The same step with other bytes (exchanges and sends; any other step unchanged).
+    pub fn with_bytes(&self, new: Vec<u8>) -> Step {
+        match self {
+            Step::Exchange {
+                compare,
+                silence_ok,
+                ..
+            } => Step::Exchange {
+                bytes: new,
+                compare: *compare,
+                silence_ok: *silence_ok,
+            },
+            Step::Send { .. } => Step::Send { bytes: new },
+            other => other.clone(),
+        }
+    }
+}
+
+/// Bytes as spaced hex text (`7E 80 01`); any form `drivespec_spec::hex::parse_hex` reads.
+mod hex_text {
+    use drivespec_spec::hex::{parse_hex, to_hex};
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub(super) fn serialize<S: Serializer>(bytes: &[u8], s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&to_hex(bytes))
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
+        let text = String::deserialize(d)?;
+        parse_hex(&text).map_err(|e| serde::de::Error::custom(format!("hex: {e}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn read(text: &str) -> Result<Step, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    #[test]
+    fn steps_read_with_their_keys() {
+        assert_eq!(
+            read("do = \"exchange\"\nhex = \"02 C6 48\"\ncompare = { mask = 65280 }").unwrap(),
+            Step::Exchange {
+                bytes: vec![0x02, 0xC6, 0x48],
+                compare: Compare::Mask(0xFF00),
+                silence_ok: false,
+            }
+        );
+        assert_eq!(
+            read("do = \"exchange\"\nhex = \"02C648\"\nsilence_ok = true").unwrap(),
+            Step::Exchange {
+                bytes: vec![0x02, 0xC6, 0x48],
+                compare: Compare::Exact,
+                silence_ok: true,
+            }
+        );
+        assert_eq!(
+            read("do = \"listen\"\nus = 6144").unwrap(),
+            Step::Listen { us: 6144 }
+        );
+        assert_eq!(
+            read("do = \"listen-half-timeout\"").unwrap(),
+            Step::ListenHalfTimeout {}
+        );
+        assert_eq!(
+            read("do = \"inputs\"\nvalue = 5").unwrap(),
+            Step::Inputs { value: 5 }
+        );
+    }
+
+    #[test]
+    fn misspelt_keys_missing_keys_and_bad_hex_are_refused() {
+        let e = read("do = \"listen\"\nuss = 5").unwrap_err().to_string();
+        assert!(e.contains("uss"), "{e}");
+        let e = read("do = \"exchange\"\nhex = \"02\"\ncompre = \"exact\"")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("compre"), "{e}");
+        let e = read("do = \"send\"").unwrap_err().to_string();
+        assert!(e.contains("hex"), "{e}");
+        let e = read("do = \"send\"\nhex = \"0G\"").unwrap_err().to_string();
+        assert!(e.contains("hex:"), "{e}");
+        let e = read("do = \"power-cycle\"\nus = 5")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("us"), "{e}");
+        let e = read("do = \"nap\"").unwrap_err().to_string();
+        assert!(e.contains("nap"), "{e}");
+    }
+
+    #[test]
+    fn names_bytes_and_round_trip() {
+        let steps = [
+            Step::Exchange {
+                bytes: vec![0x7E, 0x80],
+                compare: Compare::Near(3),
+                silence_ok: true,
+            },
+            Step::Send { bytes: vec![1] },
+            Step::Listen { us: 7 },
+            Step::ListenTimeout {},
+            Step::ListenHalfTimeout {},
+            Step::PowerCycle {},
+            Step::Inputs { value: 0xFFFF },
+            Step::BitRate {},
+        ];
+        for s in &steps {
+            let text = toml::to_string(s).unwrap();
+            assert!(text.contains(&format!("do = \"{}\"", s.name())), "{text}");
+            assert_eq!(&read(&text).unwrap(), s, "{text}");
+        }
+        assert_eq!(
+            steps[0].with_bytes(vec![2]),
+            Step::Exchange {
+                bytes: vec![2],
+                compare: Compare::Near(3),
+                silence_ok: true,
+            }
+        );
+        assert_eq!(steps[1].with_bytes(vec![2]).bytes(), Some(&[2u8][..]));
+        assert_eq!(steps[2].with_bytes(vec![2]), steps[2]);
+        assert_eq!(steps[2].bytes(), None);
+    }
+}
