@@ -6,11 +6,13 @@
 
 mod sequence;
 
+use super::session::env_request;
 use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
 use drivespec_psx3xx::guard::Guards;
-use drivespec_psx3xx::isdu::{Request, Target, Value};
+use drivespec_psx3xx::isdu::{Target, Value};
 use drivespec_psx3xx::model::Drive;
+use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Output, Rules, Stamp, TsCode};
 use drivespec_spec::{Access, DataType, DeviceModel, Family, FamilyId, Level, Parameter, Readings};
 
@@ -41,31 +43,8 @@ mod isdu {
     pub const STANDARD_COMMAND: &str = "2";
 }
 
-/// One action of a case; the device and the reference get exactly the same inputs.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Action {
-    /// A new process output (in the format active at that point), then one cycle.
-    Out(Output),
-    /// Cycles with the output unchanged.
-    Hold(u32),
-    /// Cycles until the reference's status bit "Drive is running" is set (`true`) or the
-    /// reference stands still (`false`), at most `max`.
-    Until {
-        /// Wait for running (true) or standstill (false).
-        running: bool,
-        /// Most cycles.
-        max: u32,
-    },
-    /// The master stays silent this long (µs): time passes without bus cycles.
-    Silence(u64),
-    /// An ISDU request between two cycles.
-    Isdu(Request),
-    /// An environment injection.
-    Env(Env),
-}
-
 /// One step of a case.
-pub(crate) type StepDef = crate::cyclic_session::StepDef<Action>;
+pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
 
 pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
 
@@ -90,7 +69,48 @@ pub(crate) struct PsxCase {
     pub plot: bool,
 }
 
-fn step(role: Role, text: impl Into<String>, action: Action) -> StepDef {
+/// A process output in the format of `out`, then one cycle (manual 3.3.1).
+pub(crate) fn pd_out(out: Output) -> Step {
+    match out {
+        Output::TimeStamp { control, stamp } => Step::PdOut {
+            format: 0,
+            control: u16::from(control.0),
+            target: 0,
+            speed: 0,
+            stamp: stamp.0,
+        },
+        Output::ControlTarget {
+            control_word,
+            target,
+        } => Step::PdOut {
+            format: 1,
+            control: control_word,
+            target,
+            speed: 0,
+            stamp: 0,
+        },
+        Output::SpeedControlTarget {
+            target_speed,
+            control_word,
+            target,
+        } => Step::PdOut {
+            format: 2,
+            control: control_word,
+            target,
+            speed: target_speed,
+            stamp: 0,
+        },
+    }
+}
+
+/// An environment change in its protocol text form.
+fn env(change: Env) -> Step {
+    Step::Env {
+        env: change.to_string(),
+    }
+}
+
+fn step(role: Role, text: impl Into<String>, action: Step) -> StepDef {
     StepDef {
         role,
         text: text.into(),
@@ -143,13 +163,20 @@ impl<'a, 's> Gen<'a, 's> {
             .find(|p| p.id == format)
             .and_then(address);
         let writes_format = case.steps.iter().any(|s| match &s.action {
-            Action::Isdu(Request::Write {
+            Step::IsduWrite {
                 index, subindex, ..
-            }) => format_index == Some((*index, *subindex)),
+            } => format_index == Some((*index, *subindex)),
             _ => false,
         });
         if writes_format {
             reqs.push(FORMAT_SWITCH.to_owned());
+        }
+        for s in &case.steps {
+            if let Step::Env { env } = &s.action {
+                if let Err(e) = env_request(0, env) {
+                    self.errors.push(format!("{id}: step {:?}: {e}", s.text));
+                }
+            }
         }
         let mut requirements: Vec<String> = Vec::new();
         let mut level = Level::Informative;
@@ -271,7 +298,7 @@ impl<'a, 's> Gen<'a, 's> {
         Some(step(
             Role::Check,
             format!("ISDU read {id} ({})", p.name),
-            Action::Isdu(Request::Read { index, subindex }),
+            Step::IsduRead { index, subindex },
         ))
     }
 
@@ -293,11 +320,11 @@ impl<'a, 's> Gen<'a, 's> {
         Some(step(
             role,
             format!("ISDU write {id} ({}) = {value}", p.name),
-            Action::Isdu(Request::Write {
+            Step::IsduWrite {
                 index,
                 subindex,
                 data,
-            }),
+            },
         ))
     }
 
@@ -335,30 +362,30 @@ impl<'a, 's> Gen<'a, 's> {
         })
     }
 
-    fn f1(&self, control_word: u16, target: i64) -> Action {
-        Action::Out(Output::ControlTarget {
+    fn f1(&self, control_word: u16, target: i64) -> Step {
+        pd_out(Output::ControlTarget {
             control_word,
             target: i32::try_from(target).unwrap_or(0),
         })
     }
 
-    fn f2(&self, target_speed: i16, control_word: u16, target: i64) -> Action {
-        Action::Out(Output::SpeedControlTarget {
+    fn f2(&self, target_speed: i16, control_word: u16, target: i64) -> Step {
+        pd_out(Output::SpeedControlTarget {
             target_speed,
             control_word,
             target: i32::try_from(target).unwrap_or(0),
         })
     }
 
-    fn f0(&self, code: u8, stamp: Stamp) -> Action {
-        Action::Out(Output::TimeStamp {
+    fn f0(&self, code: u8, stamp: Stamp) -> Step {
+        pd_out(Output::TimeStamp {
             control: TsCode(code),
             stamp,
         })
     }
 
-    fn until(running: bool) -> Action {
-        Action::Until {
+    fn until(running: bool) -> Step {
+        Step::Until {
             running,
             max: RUN_MAX,
         }
@@ -404,7 +431,7 @@ impl<'a, 's> Gen<'a, 's> {
                     steps: vec![step(
                         Role::Check,
                         format!("ISDU read {index}.{subindex}"),
-                        Action::Isdu(Request::Read { index, subindex }),
+                        Step::IsduRead { index, subindex },
                     )],
                     tol: EXACT,
                     plot: false,
@@ -424,16 +451,16 @@ impl<'a, 's> Gen<'a, 's> {
                             step(
                                 Role::Check,
                                 format!("ISDU write {index}.{subindex} with {len} zero octet(s)"),
-                                Action::Isdu(Request::Write {
+                                Step::IsduWrite {
                                     index,
                                     subindex,
                                     data: vec![0; len],
-                                }),
+                                },
                             ),
                             step(
                                 Role::Check,
                                 "read back: unchanged",
-                                Action::Isdu(Request::Read { index, subindex }),
+                                Step::IsduRead { index, subindex },
                             ),
                         ],
                         tol: EXACT,
@@ -453,7 +480,7 @@ impl<'a, 's> Gen<'a, 's> {
                 vec![step(
                     Role::Check,
                     format!("ISDU read {index}.0"),
-                    Action::Isdu(Request::Read { index, subindex: 0 }),
+                    Step::IsduRead { index, subindex: 0 },
                 )],
             );
         }
@@ -512,20 +539,20 @@ impl<'a, 's> Gen<'a, 's> {
             let mut steps = vec![step(
                 Role::Check,
                 format!("ISDU write {} = {v}", p.id),
-                Action::Isdu(Request::Write {
+                Step::IsduWrite {
                     index,
                     subindex,
                     data,
-                }),
+                },
             )];
             if p.access.readable() {
                 steps.push(step(
                     Role::Check,
                     "read back",
-                    Action::Isdu(Request::Read { index, subindex }),
+                    Step::IsduRead { index, subindex },
                 ));
             }
-            steps.push(step(Role::Check, "two cycles", Action::Hold(2)));
+            steps.push(step(Role::Check, "two cycles", Step::Hold { cycles: 2 }));
             self.push(
                 format!("psx3xx/isdu/write/{}/{name}", p.id),
                 &reqs,
@@ -578,16 +605,16 @@ impl<'a, 's> Gen<'a, 's> {
                     step(
                         Role::Check,
                         format!("ISDU read {index}.0"),
-                        Action::Isdu(Request::Read { index, subindex: 0 }),
+                        Step::IsduRead { index, subindex: 0 },
                     ),
                     step(
                         Role::Check,
                         format!("ISDU write {index}.0 = 00 01"),
-                        Action::Isdu(Request::Write {
+                        Step::IsduWrite {
                             index,
                             subindex: 0,
                             data: vec![0, 1],
-                        }),
+                        },
                     ),
                 ],
             );
@@ -631,16 +658,16 @@ impl<'a, 's> Gen<'a, 's> {
                     step(
                         Role::Check,
                         format!("ISDU read {index}.{subindex}"),
-                        Action::Isdu(Request::Read { index, subindex }),
+                        Step::IsduRead { index, subindex },
                     ),
                     step(
                         Role::Check,
                         format!("ISDU write {index}.{subindex} = 00"),
-                        Action::Isdu(Request::Write {
+                        Step::IsduWrite {
                             index,
                             subindex,
                             data: vec![0],
-                        }),
+                        },
                     ),
                 ],
             );
@@ -687,16 +714,16 @@ impl<'a, 's> Gen<'a, 's> {
                         step(
                             Role::Check,
                             format!("ISDU write {index}.{subindex} with {} octet(s)", data.len()),
-                            Action::Isdu(Request::Write {
+                            Step::IsduWrite {
                                 index,
                                 subindex,
                                 data,
-                            }),
+                            },
                         ),
                         step(
                             Role::Check,
                             "read back: unchanged",
-                            Action::Isdu(Request::Read { index, subindex }),
+                            Step::IsduRead { index, subindex },
                         ),
                     ],
                 );
@@ -758,7 +785,7 @@ impl<'a, 's> Gen<'a, 's> {
                 self.write(Role::Check, &g.guard, g.suppress),
                 self.write(Role::Check, &g.guarded, new),
                 self.read(&g.guarded),
-                Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                Some(step(Role::Check, "two cycles", Step::Hold { cycles: 2 })),
             ]
             .into_iter()
             .flatten()
@@ -775,7 +802,7 @@ impl<'a, 's> Gen<'a, 's> {
             let allow: Vec<StepDef> = [
                 self.write(Role::Check, &g.guarded, new),
                 self.read(&g.guarded),
-                Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                Some(step(Role::Check, "two cycles", Step::Hold { cycles: 2 })),
             ]
             .into_iter()
             .flatten()
@@ -832,13 +859,11 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     "saving",
-                    Action::Hold(self.cycles_for(self.save_ms())),
+                    Step::Hold {
+                        cycles: self.cycles_for(self.save_ms()),
+                    },
                 )),
-                Some(step(
-                    Role::Check,
-                    "power cycle",
-                    Action::Env(Env::PowerCycle),
-                )),
+                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                 self.read(&g.guard),
             ]
             .into_iter()
@@ -902,12 +927,14 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     "saving or running",
-                    Action::Hold(save_cycles),
+                    Step::Hold {
+                        cycles: save_cycles,
+                    },
                 )),
                 Some(step(
                     Role::Check,
                     "until standstill",
-                    Action::Until {
+                    Step::Until {
                         running: false,
                         max: RUN_MAX,
                     },
@@ -928,11 +955,7 @@ impl<'a, 's> Gen<'a, 's> {
                 [
                     self.read(probe),
                     self.read(&format_param),
-                    Some(step(
-                        Role::Check,
-                        "power cycle",
-                        Action::Env(Env::PowerCycle),
-                    )),
+                    Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                     self.read(probe),
                     self.read(&format_param),
                 ]
@@ -986,7 +1009,7 @@ impl<'a, 's> Gen<'a, 's> {
             for v in values {
                 let steps: Vec<StepDef> = [
                     self.write(Role::Check, param, v),
-                    Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                    Some(step(Role::Check, "two cycles", Step::Hold { cycles: 2 })),
                 ]
                 .into_iter()
                 .flatten()
@@ -1003,11 +1026,7 @@ impl<'a, 's> Gen<'a, 's> {
         let lost: Vec<StepDef> = [
             self.write(Role::Check, probe, probe_value),
             self.read(probe),
-            Some(step(
-                Role::Check,
-                "power cycle",
-                Action::Env(Env::PowerCycle),
-            )),
+            Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
             self.read(probe),
         ]
         .into_iter()
@@ -1023,13 +1042,15 @@ impl<'a, 's> Gen<'a, 's> {
             self.write(Role::Check, probe, probe_value),
             self.save(Role::Check),
             self.read(isdu::DELIVERY_STATE),
-            Some(step(Role::Check, "saving", Action::Hold(save_cycles))),
-            self.read(isdu::DELIVERY_STATE),
             Some(step(
                 Role::Check,
-                "power cycle",
-                Action::Env(Env::PowerCycle),
+                "saving",
+                Step::Hold {
+                    cycles: save_cycles,
+                },
             )),
+            self.read(isdu::DELIVERY_STATE),
+            Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
             self.read(probe),
         ]
         .into_iter()
@@ -1060,12 +1081,14 @@ impl<'a, 's> Gen<'a, 's> {
             let steps: Vec<StepDef> = [
                 self.write(Role::Check, &p.id, v),
                 self.save(Role::Check),
-                Some(step(Role::Check, "saving", Action::Hold(save_cycles))),
                 Some(step(
                     Role::Check,
-                    "power cycle",
-                    Action::Env(Env::PowerCycle),
+                    "saving",
+                    Step::Hold {
+                        cycles: save_cycles,
+                    },
                 )),
+                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                 self.read(&p.id),
             ]
             .into_iter()
@@ -1094,10 +1117,10 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     format!("ISDU read {}.{subindex} ({})", dp.isdu_index, e.name),
-                    Action::Isdu(Request::Read {
+                    Step::IsduRead {
                         index: dp.isdu_index,
                         subindex,
-                    }),
+                    },
                 ))
             })
             .collect()
@@ -1124,7 +1147,13 @@ impl<'a, 's> Gen<'a, 's> {
         let mut steps: Vec<StepDef> = [
             self.write(role, &param, i64::from(format)),
             self.save(role),
-            Some(step(role, "saving", Action::Hold(save_cycles))),
+            Some(step(
+                role,
+                "saving",
+                Step::Hold {
+                    cycles: save_cycles,
+                },
+            )),
             self.write(role, &reset_param, reset_value),
         ]
         .into_iter()
@@ -1133,7 +1162,7 @@ impl<'a, 's> Gen<'a, 's> {
         steps.push(step(
             role,
             format!("format {format} idle output"),
-            Action::Out(self.idle(format)),
+            pd_out(self.idle(format)),
         ));
         steps
     }
@@ -1149,14 +1178,14 @@ impl<'a, 's> Gen<'a, 's> {
             steps.push(step(
                 Role::Check,
                 "cycles in the old format",
-                Action::Hold(2),
+                Step::Hold { cycles: 2 },
             ));
             steps.extend(self.device_id_reads());
             steps.extend(self.switch_to(f, Role::Check));
             steps.push(step(
                 Role::Check,
                 "cycles in the new format",
-                Action::Hold(2),
+                Step::Hold { cycles: 2 },
             ));
             steps.extend(self.device_id_reads());
             let mut reqs = vec![
@@ -1180,13 +1209,13 @@ impl<'a, 's> Gen<'a, 's> {
             );
             let unsaved: Vec<StepDef> = [
                 self.write(Role::Check, &param, i64::from(f)),
+                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
+                self.read(&param),
                 Some(step(
                     Role::Check,
-                    "power cycle",
-                    Action::Env(Env::PowerCycle),
+                    "cycles in format 1",
+                    Step::Hold { cycles: 2 },
                 )),
-                self.read(&param),
-                Some(step(Role::Check, "cycles in format 1", Action::Hold(2))),
             ]
             .into_iter()
             .flatten()
@@ -1268,7 +1297,7 @@ impl<'a, 's> Gen<'a, 's> {
                     self.f2(low, transfer, target),
                 )),
                 Some(step(Role::Check, "until running", Self::until(true))),
-                Some(step(Role::Check, "running", Action::Hold(20))),
+                Some(step(Role::Check, "running", Step::Hold { cycles: 20 })),
                 Some(step(
                     Role::Check,
                     format!("speed {fast} during the run"),
@@ -1294,7 +1323,7 @@ impl<'a, 's> Gen<'a, 's> {
                 format!("speed {bad} (above the range), 0x14 to start+8000"),
                 self.f2(bad, transfer, target),
             ),
-            step(Role::Check, "no run", Action::Hold(10)),
+            step(Role::Check, "no run", Step::Hold { cycles: 10 }),
             step(
                 Role::Check,
                 format!("speed {fast}: the run starts"),
@@ -1324,7 +1353,7 @@ impl<'a, 's> Gen<'a, 's> {
                 self.f2(low, manual, 0),
             ),
             step(Role::Check, "until running", Self::until(true)),
-            step(Role::Check, "manual run", Action::Hold(25)),
+            step(Role::Check, "manual run", Step::Hold { cycles: 25 }),
             step(Role::Check, "0x10: stop", self.f2(low, release, 0)),
             step(Role::Check, "until standstill", Self::until(false)),
         ]);
@@ -1406,10 +1435,10 @@ impl<'a, 's> Gen<'a, 's> {
             step(
                 Role::Check,
                 "the valid stamp repeated: nothing runs",
-                Action::Hold(30),
+                Step::Hold { cycles: 30 },
             ),
             step(Role::Check, "code 3, stamp 3000", self.f0(3, Stamp(3000))),
-            step(Role::Check, "still nothing", Action::Hold(10)),
+            step(Role::Check, "still nothing", Step::Hold { cycles: 10 }),
             step(Role::Check, "stamp inactive", self.f0(3, inactive)),
             step(Role::Check, "until running", Self::until(true)),
             step(Role::Check, "until standstill", Self::until(false)),
@@ -1431,7 +1460,7 @@ impl<'a, 's> Gen<'a, 's> {
                 ),
                 step(Role::Check, "stamp inactive", self.f0(code, inactive)),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(25)),
+                step(Role::Check, "manual run", Step::Hold { cycles: 25 }),
                 step(Role::Check, "code 0, stamp 0: cancel", self.f0(0, Stamp(0))),
                 step(Role::Check, "until standstill", Self::until(false)),
             ]);
@@ -1482,7 +1511,7 @@ impl<'a, 's> Gen<'a, 's> {
             "status/power-on",
             &["PSX-STS-LAYOUT", "PSX-STS-4-SET-1"],
             "status word after power-on",
-            vec![step(Role::Check, "three cycles", Action::Hold(3))],
+            vec![step(Role::Check, "three cycles", Step::Hold { cycles: 3 })],
         );
         self.motion(
             "status/target-reached",
@@ -1522,11 +1551,11 @@ impl<'a, 's> Gen<'a, 's> {
                     self.f1(transfer, start + 20_000),
                 ),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "running", Action::Hold(10)),
+                step(Role::Check, "running", Step::Hold { cycles: 10 }),
                 step(Role::Check, "0x00", self.f1(0, start + 20_000)),
                 step(Role::Check, "until standstill", Self::until(false)),
                 step(Role::Check, "bit 14 set", self.f1(clear, start + 20_000)),
-                step(Role::Check, "held", Action::Hold(3)),
+                step(Role::Check, "held", Step::Hold { cycles: 3 }),
             ],
         );
         let umot = self.value(isdu::UMOT_LIMIT);
@@ -1543,21 +1572,21 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     format!("motor voltage {} (0.1 V)", umot - 10),
-                    Action::Env(Env::MotorVoltage(u16::try_from(umot - 10).unwrap_or(0))),
+                    env(Env::MotorVoltage(u16::try_from(umot - 10).unwrap_or(0))),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(
                     Role::Check,
                     "0x14 to start+2000",
                     self.f1(transfer, start + 2000),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(
                     Role::Check,
                     "motor voltage 240",
-                    Action::Env(Env::MotorVoltage(240)),
+                    env(Env::MotorVoltage(240)),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
             ],
         );
         let tmax = self.value(isdu::TEMPERATURE_LIMIT);
@@ -1569,15 +1598,15 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     format!("temperature {} °C", tmax + 1),
-                    Action::Env(Env::Temperature(i16::try_from(tmax + 1).unwrap_or(0))),
+                    env(Env::Temperature(i16::try_from(tmax + 1).unwrap_or(0))),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(
                     Role::Check,
                     format!("temperature {} °C", tmax - 6),
-                    Action::Env(Env::Temperature(i16::try_from(tmax - 6).unwrap_or(0))),
+                    env(Env::Temperature(i16::try_from(tmax - 6).unwrap_or(0))),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
             ],
         );
         let window = self.value(isdu::WINDOW);
@@ -1591,9 +1620,9 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     format!("displaced by {}", window + 50),
-                    Action::Env(Env::Displace(window + 50)),
+                    env(Env::Displace(window + 50)),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(Role::Check, "0x14 to start", self.f1(transfer, start)),
                 step(Role::Check, "until standstill", Self::until(false)),
             ],
@@ -1609,7 +1638,7 @@ impl<'a, 's> Gen<'a, 's> {
                     "0x14 to ISDU 129 + 10",
                     self.f1(transfer, upper + 10),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(Role::Check, "0x10", self.f1(release, upper + 10)),
                 step(
                     Role::Check,
@@ -1626,7 +1655,7 @@ impl<'a, 's> Gen<'a, 's> {
             vec![
                 step(Role::Check, "0x12", self.f1(manual_down, start)),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(20)),
+                step(Role::Check, "manual run", Step::Hold { cycles: 20 }),
                 step(Role::Check, "0x10: stop", self.f1(release, start)),
                 step(Role::Check, "until standstill", Self::until(false)),
             ],
@@ -1644,34 +1673,34 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     "forward key",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: true,
                         reverse: false,
                     }),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(
                     Role::Check,
                     "both keys",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: true,
                         reverse: true,
                     }),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(
                     Role::Check,
                     "reverse key",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: false,
                         reverse: true,
                     }),
                 ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
                 step(
                     Role::Check,
                     "no key",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: false,
                         reverse: false,
                     }),
@@ -1690,10 +1719,10 @@ impl<'a, 's> Gen<'a, 's> {
                     self.f1(transfer, start + 20_000),
                 ),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "jam", Action::Env(Env::Jam(true))),
+                step(Role::Check, "jam", env(Env::Jam(true))),
                 step(Role::Check, "until standstill", Self::until(false)),
-                step(Role::Check, "cycles", Action::Hold(40)),
-                step(Role::Check, "free", Action::Env(Env::Jam(false))),
+                step(Role::Check, "cycles", Step::Hold { cycles: 40 }),
+                step(Role::Check, "free", env(Env::Jam(false))),
                 step(Role::Check, "0x10", self.f1(release, start)),
                 step(Role::Check, "0x14 to start", self.f1(transfer, start)),
                 step(Role::Check, "until standstill", Self::until(false)),
@@ -1704,13 +1733,9 @@ impl<'a, 's> Gen<'a, 's> {
             &["PSX-STS-9-SET-1"],
             "an internal position fault sets bit 9",
             vec![
-                step(Role::Check, "cycles", Action::Hold(2)),
-                step(
-                    Role::Check,
-                    "position fault",
-                    Action::Env(Env::PositionFault),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
+                step(Role::Check, "cycles", Step::Hold { cycles: 2 }),
+                step(Role::Check, "position fault", env(Env::PositionFault)),
+                step(Role::Check, "cycles", Step::Hold { cycles: SETTLE }),
             ],
         );
         // Manual runs to narrowed end limits (ISDU 129 / 130): bits 14 and 15.
@@ -1733,7 +1758,11 @@ impl<'a, 's> Gen<'a, 's> {
                 )),
                 Some(step(Role::Check, "until running", Self::until(true))),
                 Some(step(Role::Check, "until standstill", Self::until(false))),
-                Some(step(Role::Check, "held at the limit", Action::Hold(SETTLE))),
+                Some(step(
+                    Role::Check,
+                    "held at the limit",
+                    Step::Hold { cycles: SETTLE },
+                )),
                 Some(step(
                     Role::Check,
                     "0x14 to start: bit cleared",
@@ -1776,18 +1805,18 @@ impl<'a, 's> Gen<'a, 's> {
             Some(step(
                 Role::Check,
                 "connection lost",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
+                env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
             )),
             Some(step(
                 Role::Check,
                 "silence 300 ms",
-                Action::Silence(silence),
+                Step::Advance { us: silence },
             )),
             self.read(isdu::ACTUAL),
             Some(step(
                 Role::Check,
                 "connected",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
+                env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
             )),
             Some(step(Role::Check, "until standstill", Self::until(false))),
         ]
@@ -1821,18 +1850,20 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     "kept alive: cycles for 200 ms",
-                    Action::Hold(self.cycles_for(200)),
+                    Step::Hold {
+                        cycles: self.cycles_for(200),
+                    },
                 )),
                 Some(step(
                     Role::Check,
                     "silence 300 ms",
-                    Action::Silence(silence),
+                    Step::Advance { us: silence },
                 )),
                 self.read(isdu::STATUS),
                 Some(step(
                     Role::Check,
                     "silence 10 s",
-                    Action::Silence(10_000_000),
+                    Step::Advance { us: 10_000_000 },
                 )),
                 self.read(isdu::STATUS),
                 self.read(isdu::ACTUAL),
@@ -1927,7 +1958,7 @@ impl<'a, 's> Gen<'a, 's> {
                     self.f1(transfer, start + 20_000),
                 ),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "running", Action::Hold(20)),
+                step(Role::Check, "running", Step::Hold { cycles: 20 }),
                 step(
                     Role::Check,
                     "0x14 to start+10000",
@@ -1946,7 +1977,7 @@ impl<'a, 's> Gen<'a, 's> {
                     "0x04 to start+3000",
                     self.f1(only_transfer, start + 3000),
                 ),
-                step(Role::Check, "no run", Action::Hold(10)),
+                step(Role::Check, "no run", Step::Hold { cycles: 10 }),
                 step(Role::Check, "0x10", self.f1(release, start + 3000)),
                 step(Role::Check, "until running", Self::until(true)),
                 step(Role::Check, "until standstill", Self::until(false)),
@@ -1959,7 +1990,7 @@ impl<'a, 's> Gen<'a, 's> {
             vec![
                 step(Role::Check, "0x11", self.f1(up, start)),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(25)),
+                step(Role::Check, "manual run", Step::Hold { cycles: 25 }),
                 step(Role::Check, "0x10", self.f1(release, start)),
                 step(Role::Check, "until standstill", Self::until(false)),
             ],
@@ -1971,7 +2002,7 @@ impl<'a, 's> Gen<'a, 's> {
             vec![
                 step(Role::Check, "0x11", self.f1(up, start)),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(15)),
+                step(Role::Check, "manual run", Step::Hold { cycles: 15 }),
                 step(
                     Role::Check,
                     "0x14 to start+6000",
@@ -1999,16 +2030,16 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     "forward key",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: true,
                         reverse: false,
                     }),
                 ),
-                step(Role::Check, "cycles", Action::Hold(2)),
+                step(Role::Check, "cycles", Step::Hold { cycles: 2 }),
                 step(
                     Role::Check,
                     "released",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: false,
                         reverse: false,
                     }),
@@ -2030,7 +2061,7 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     "reverse key held",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: false,
                         reverse: true,
                     }),
@@ -2038,12 +2069,14 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     format!("held {hold} ms"),
-                    Action::Hold(self.cycles_for(hold)),
+                    Step::Hold {
+                        cycles: self.cycles_for(hold),
+                    },
                 ),
                 step(
                     Role::Check,
                     "both keys",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: true,
                         reverse: true,
                     }),
@@ -2052,12 +2085,12 @@ impl<'a, 's> Gen<'a, 's> {
                 step(
                     Role::Check,
                     "released",
-                    Action::Env(Env::Keys {
+                    env(Env::Keys {
                         forward: false,
                         reverse: false,
                     }),
                 ),
-                step(Role::Check, "cycles", Action::Hold(3)),
+                step(Role::Check, "cycles", Step::Hold { cycles: 3 }),
             ],
         );
         let jog_bit = self.control_bit("Jog to larger values");
@@ -2067,7 +2100,7 @@ impl<'a, 's> Gen<'a, 's> {
             "control bit 8 jogs like the forward key",
             vec![
                 step(Role::Check, "control bit 8", self.f1(jog_bit, start)),
-                step(Role::Check, "cycles", Action::Hold(2)),
+                step(Role::Check, "cycles", Step::Hold { cycles: 2 }),
                 step(Role::Check, "0x00", self.f1(0, start)),
                 step(Role::Check, "until standstill", Self::until(false)),
             ],
@@ -2077,12 +2110,12 @@ impl<'a, 's> Gen<'a, 's> {
             Some(step(
                 Role::Check,
                 "connection lost",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
+                env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
             )),
             Some(step(
                 Role::Check,
                 "forward key held",
-                Action::Env(Env::Keys {
+                env(Env::Keys {
                     forward: true,
                     reverse: false,
                 }),
@@ -2090,24 +2123,28 @@ impl<'a, 's> Gen<'a, 's> {
             Some(step(
                 Role::Check,
                 format!("held {hold} ms"),
-                Action::Silence(key_hold),
+                Step::Advance { us: key_hold },
             )),
             Some(step(
                 Role::Check,
                 "released",
-                Action::Env(Env::Keys {
+                env(Env::Keys {
                     forward: false,
                     reverse: false,
                 }),
             )),
-            Some(step(Role::Check, "silence 2 s", Action::Silence(2_000_000))),
+            Some(step(
+                Role::Check,
+                "silence 2 s",
+                Step::Advance { us: 2_000_000 },
+            )),
             Some(step(
                 Role::Check,
                 "connected",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
+                env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
             )),
             self.read(isdu::ACTUAL),
-            Some(step(Role::Check, "cycles", Action::Hold(3))),
+            Some(step(Role::Check, "cycles", Step::Hold { cycles: 3 })),
         ]
         .into_iter()
         .flatten()
@@ -2126,7 +2163,7 @@ impl<'a, 's> Gen<'a, 's> {
                 "0x14 to ISDU 129 with a backward loop",
                 self.f1(transfer, upper),
             )),
-            Some(step(Role::Check, "refused", Action::Hold(SETTLE))),
+            Some(step(Role::Check, "refused", Step::Hold { cycles: SETTLE })),
         ]
         .into_iter()
         .flatten()
