@@ -1494,6 +1494,25 @@ impl<'a, 's> Gen<'a, 's> {
     }
 }
 
+/// Why the PSx3xx cases cannot be generated from the spec.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub(crate) enum GenerateError {
+    /// The spec lacks what cases need: the first problem and how many there are.
+    #[error("{first} ({count} problem(s))")]
+    Spec {
+        /// The first problem.
+        first: String,
+        /// How many.
+        count: usize,
+    },
+    /// Two cases have the same id.
+    #[error("duplicate case id {id}")]
+    DuplicateId {
+        /// The id.
+        id: String,
+    },
+}
+
 /// Every case for `model`, in run order; `base` is the reference drive at power-on and
 /// `cycle_us` the bus cycle.
 pub(crate) fn generate<'s>(
@@ -1501,7 +1520,7 @@ pub(crate) fn generate<'s>(
     model: &DeviceModel,
     base: &Drive<'s>,
     cycle_us: u64,
-) -> Result<(Vec<CaseInfo>, Vec<PsxCase>), String> {
+) -> Result<(Vec<CaseInfo>, Vec<PsxCase>), GenerateError> {
     let mut g = Gen {
         family,
         model,
@@ -1519,12 +1538,17 @@ pub(crate) fn generate<'s>(
     g.scenario_cases();
     g.sequence_cases();
     if let Some(e) = g.errors.first() {
-        return Err(format!("{e} ({} problem(s))", g.errors.len()));
+        return Err(GenerateError::Spec {
+            first: e.clone(),
+            count: g.errors.len(),
+        });
     }
     let mut seen = std::collections::BTreeSet::new();
     for (info, _) in &g.out {
         if !seen.insert(info.id.clone()) {
-            return Err(format!("duplicate case id {}", info.id));
+            return Err(GenerateError::DuplicateId {
+                id: info.id.clone(),
+            });
         }
     }
     Ok(g.out.into_iter().unzip())
