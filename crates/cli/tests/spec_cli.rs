@@ -140,6 +140,37 @@ fn misspelt_step_key_fails_check_naming_file_record_and_key() {
     );
 }
 
+/// A misspelt key in a step of a PSx3xx scenario fails `spec check` naming file, scenario,
+/// step and key.
+#[test]
+fn misspelt_scenario_step_key_fails_check_naming_file_scenario_step_and_key() {
+    let dir = std::env::temp_dir().join(format!("drivespec-scenarios-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec");
+    copy_dir(std::path::Path::new(src), &dir);
+    let path = dir.join("psx3xx/scenarios/status.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let from = "{ text = \"three cycles\", do = \"hold\", cycles = 3 }";
+    assert_eq!(text.matches(from).count(), 1, "{from}");
+    std::fs::write(
+        &path,
+        text.replace(from, &from.replace("cycles = 3", "cycels = 3")),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = run(BIN, &["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 1, "{stdout}");
+    assert!(
+        lines[0].starts_with(
+            "psx3xx/scenarios/status.toml: scenario \"status/power-on\": steps[1]: unknown field `cycels`"
+        ),
+        "{}",
+        lines[0]
+    );
+}
+
 #[test]
 fn check_json_is_machine_readable() {
     let (code, stdout, _) = run(BIN, &["spec", "check", "--format", "json"]);
@@ -189,7 +220,7 @@ fn without_requirement(text: &str, id: &str) -> String {
 fn a_spec_edit_that_breaks_case_generation_fails_check() {
     // Only a PSx3xx case cites this requirement: the spec loads, the cases cannot be made.
     let (code, stdout, stderr) = check_edited("no-case-requirement", "psx3xx", |t| {
-        without_requirement(t, "PSX-ISDU-181-BIT4")
+        without_requirement(t, "PSX-PAR-NOT-SAVED")
     });
     assert_eq!(code, 1, "{}{}", stdout, stderr);
     assert!(!stdout.contains("spec ok"), "{}", stdout);
@@ -197,7 +228,7 @@ fn a_spec_edit_that_breaks_case_generation_fails_check() {
     assert!(
         lines.iter().any(|l| l.starts_with(
             "psx3xx: model \"PSE312-8\": the conformance cases cannot be generated: "
-        ) && l.contains("unknown requirement PSX-ISDU-181-BIT4")),
+        ) && l.contains("unknown requirement PSX-PAR-NOT-SAVED")),
         "{}",
         stdout
     );

@@ -41,6 +41,7 @@ pub mod isdu;
 pub mod model;
 pub mod repr;
 pub mod rules;
+pub mod scenario;
 pub mod script;
 pub mod step;
 pub mod timestamp;

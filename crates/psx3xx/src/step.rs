@@ -11,6 +11,116 @@ use drivespec_spec::{Problem, Spec};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
+/// One master action or environment change on a PSx3xx drive, as the suites, scenario files,
+/// sim-run scripts and fuzz replay files write it: `do` names the action, the other keys are
+/// its own (manual 3.1, 3.3.1; a misspelt key is an error naming the key).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "do", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Step {
+    /// A process output in `format`, then one cycle (3.3.1): format 0 sends `control` as the
+    /// time-stamp code with `stamp`, format 1 the control word and `target`, format 2 also
+    /// `speed`.
+    PdOut {
+        /// Output format (0, 1, 2).
+        format: u8,
+        /// Control word (formats 1, 2) or time-stamp code (format 0).
+        control: u16,
+        /// Target position (formats 1, 2).
+        #[serde(default, skip_serializing_if = "is_zero_i32")]
+        target: i32,
+        /// Target speed, rpm (format 2).
+        #[serde(default, skip_serializing_if = "is_zero_i16")]
+        speed: i16,
+        /// Time stamp (format 0).
+        #[serde(default, skip_serializing_if = "is_zero_u16")]
+        stamp: u16,
+    },
+    /// Cycles with the output unchanged.
+    Hold {
+        /// How many.
+        cycles: u32,
+    },
+    /// Cycles until the drive reports a run (`running`) or stands still, at most `max`.
+    Until {
+        /// Wait for "drive is running" set (true) or a standstill (false).
+        running: bool,
+        /// Most cycles.
+        max: u32,
+    },
+    /// The master stays silent: time passes without a bus cycle.
+    Advance {
+        /// How long, µs.
+        us: u64,
+    },
+    /// An ISDU read between two cycles (3.1).
+    IsduRead {
+        /// ISDU index.
+        index: u16,
+        /// Sub-index.
+        #[serde(default)]
+        subindex: u8,
+    },
+    /// An ISDU write between two cycles, most significant octet first (3.1).
+    IsduWrite {
+        /// ISDU index.
+        index: u16,
+        /// Sub-index.
+        #[serde(default)]
+        subindex: u8,
+        /// The octets, written as hex text (`00 2A`).
+        #[serde(rename = "hex", with = "hex_text")]
+        data: Vec<u8>,
+    },
+    /// An environment change in the cyclic-exchange protocol's text form (`jam 1`,
+    /// `keys forward`, `link lost`; README "Cyclic-exchange protocol").
+    Env {
+        /// The change.
+        env: String,
+    },
+}
+
+fn is_zero_i32(v: &i32) -> bool {
+    *v == 0
+}
+
+fn is_zero_i16(v: &i16) -> bool {
+    *v == 0
+}
+
+fn is_zero_u16(v: &u16) -> bool {
+    *v == 0
+}
+
+/// The octets of an ISDU write as hex text (`7E 21 02`).
+mod hex_text {
+    use drivespec_spec::hex::{parse_hex, to_hex};
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub(super) fn serialize<S: Serializer>(data: &[u8], s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&to_hex(data))
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
+        let text = String::deserialize(d)?;
+        parse_hex(&text).map_err(serde::de::Error::custom)
+    }
+}
+
+impl Step {
+    /// The `do` name of the step.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Step::PdOut { .. } => "pd-out",
+            Step::Hold { .. } => "hold",
+            Step::Until { .. } => "until",
+            Step::Advance { .. } => "advance",
+            Step::IsduRead { .. } => "isdu-read",
+            Step::IsduWrite { .. } => "isdu-write",
+            Step::Env { .. } => "env",
+        }
+    }
+}
+
 /// The `input` of a sequence vector.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -23,7 +133,7 @@ pub struct Input {
     pub state: State,
     /// The steps, in order.
     #[serde(default)]
-    pub steps: Vec<Step>,
+    pub steps: Vec<VectorStep>,
 }
 
 /// The `expect` of a sequence vector: what holds after the last step.
@@ -56,17 +166,17 @@ pub struct PsxSequence {
 impl Sequence for PsxSequence {
     type Input = Input;
     type Expect = Final;
-    type Step = Step;
+    type Step = VectorStep;
     fn new(input: Input, expect: Final) -> PsxSequence {
         PsxSequence { input, expect }
     }
 }
 
-/// One step: at most one of each action, in the order process data, ISDU, event; then the
-/// expectations.
+/// One step of a `sequence` vector: at most one of each action, in the order process data,
+/// ISDU, event; then the expectations.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Step {
+pub struct VectorStep {
     /// A new process output in the active format.
     #[serde(default)]
     pub pd: Option<ProcessData>,
@@ -302,4 +412,58 @@ pub struct Expect {
 /// and key (`drivespec spec check`).
 pub fn check_steps(spec: &Spec) -> Vec<Problem> {
     check_sequences::<PsxSequence>(spec.family(drivespec_spec::FamilyId::Psx3xx))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Step;
+
+    fn read(text: &str) -> Result<Step, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    #[test]
+    fn a_step_reads_its_keys() {
+        assert_eq!(
+            read("do = \"isdu-write\"\nindex = 135\nhex = \"00 2A\"").ok(),
+            Some(Step::IsduWrite {
+                index: 135,
+                subindex: 0,
+                data: vec![0, 0x2A],
+            })
+        );
+        assert_eq!(
+            read("do = \"pd-out\"\nformat = 1\ncontrol = 3\ntarget = -5").ok(),
+            Some(Step::PdOut {
+                format: 1,
+                control: 3,
+                target: -5,
+                speed: 0,
+                stamp: 0,
+            })
+        );
+    }
+
+    #[test]
+    fn a_misspelt_key_is_an_error_naming_it() {
+        let e = read("do = \"hold\"\ncycels = 3")
+            .err()
+            .map(|e| e.to_string());
+        assert!(e.as_deref().is_some_and(|e| e.contains("cycels")), "{e:?}");
+        let e = read("do = \"isdu-read\"\nindex = 1\nsubindx = 2")
+            .err()
+            .map(|e| e.to_string());
+        assert!(e.as_deref().is_some_and(|e| e.contains("subindx")), "{e:?}");
+    }
+
+    #[test]
+    fn a_step_writes_what_it_reads() {
+        let s = Step::IsduWrite {
+            index: 193,
+            subindex: 1,
+            data: vec![1, 2],
+        };
+        let text = toml::to_string(&s).unwrap_or_default();
+        assert_eq!(read(&text).ok(), Some(s));
+    }
 }

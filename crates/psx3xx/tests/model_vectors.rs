@@ -17,7 +17,7 @@ use drivespec_psx3xx::isdu::{Response, Value};
 use drivespec_psx3xx::model::{DriveConfig, Event, JogKeys, LinkEvent};
 use drivespec_psx3xx::step::{
     Direction, Event as StepEvent, Expect, Input, IsduOp, Key, LoopSide, ProcessData, PsxSequence,
-    Run, Step,
+    Run, VectorStep,
 };
 use drivespec_psx3xx::Output;
 use drivespec_spec::{Vector, VectorKind, VectorResult};
@@ -155,7 +155,7 @@ fn check(s: &mut Sim, expect: &Expect, started: &mut Option<Vec<i64>>) -> Result
 }
 
 /// Runs one step: the action, then its expectations.
-fn step(s: &mut Sim, st: &Step, started: &mut Option<Vec<i64>>) -> Result<(), String> {
+fn step(s: &mut Sim, st: &VectorStep, started: &mut Option<Vec<i64>>) -> Result<(), String> {
     let expect = &st.expect;
     if st.bus.is_some() || st.key.is_some() {
         // Each row of the jog tables is its own situation: the previous jog ends first.

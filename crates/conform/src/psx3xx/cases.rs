@@ -4,13 +4,16 @@
 //! time-out table, the spec's `sequence` vectors ([`sequence`]), plus hand-written status,
 //! time-out and positioning sequences (manual 3–5).
 
+mod scenario;
 mod sequence;
 
+use super::session::env_request;
 use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
 use drivespec_psx3xx::guard::Guards;
-use drivespec_psx3xx::isdu::{Request, Target, Value};
+use drivespec_psx3xx::isdu::{Target, Value};
 use drivespec_psx3xx::model::Drive;
+use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Output, Rules, Stamp, TsCode};
 use drivespec_spec::{Access, DataType, DeviceModel, Family, FamilyId, Level, Parameter, Readings};
 
@@ -19,53 +22,18 @@ use drivespec_spec::{Access, DataType, DeviceModel, Family, FamilyId, Level, Par
 mod isdu {
     /// ISDU 12, device access locks (bit 0: parameter write lock).
     pub const LOCKS: &str = "12";
-    /// ISDU 64, status word (3.4).
-    pub const STATUS: &str = "64";
     /// ISDU 67, actual position.
     pub const ACTUAL: &str = "67";
-    /// ISDU 131, positioning window.
-    pub const WINDOW: &str = "131";
-    /// ISDU 134, loop direction.
-    pub const LOOP_DIRECTION: &str = "134";
     /// ISDU 135, jog increment: the saved entry the save and lock cases change.
     pub const PROBE: &str = "135";
-    /// ISDU 163, wait time for a manual run in jog mode (5 ms steps).
-    pub const JOG_WAIT: &str = "163";
-    /// ISDU 181, motor voltage limit (0.1 V).
-    pub const UMOT_LIMIT: &str = "181";
-    /// ISDU 182, temperature limit (°C).
-    pub const TEMPERATURE_LIMIT: &str = "182";
     /// ISDU 193, delivery state and save command.
     pub const DELIVERY_STATE: &str = "193";
     /// ISDU 2, IO-Link standard command (write only).
     pub const STANDARD_COMMAND: &str = "2";
 }
 
-/// One action of a case; the device and the reference get exactly the same inputs.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Action {
-    /// A new process output (in the format active at that point), then one cycle.
-    Out(Output),
-    /// Cycles with the output unchanged.
-    Hold(u32),
-    /// Cycles until the reference's status bit "Drive is running" is set (`true`) or the
-    /// reference stands still (`false`), at most `max`.
-    Until {
-        /// Wait for running (true) or standstill (false).
-        running: bool,
-        /// Most cycles.
-        max: u32,
-    },
-    /// The master stays silent this long (µs): time passes without bus cycles.
-    Silence(u64),
-    /// An ISDU request between two cycles.
-    Isdu(Request),
-    /// An environment injection.
-    Env(Env),
-}
-
 /// One step of a case.
-pub(crate) type StepDef = crate::cyclic_session::StepDef<Action>;
+pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
 
 pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
 
@@ -91,7 +59,48 @@ pub(crate) struct PsxCase {
     pub plot: bool,
 }
 
-fn step(role: Role, text: impl Into<String>, action: Action) -> StepDef {
+/// A process output in the format of `out`, then one cycle (manual 3.3.1).
+pub(crate) fn pd_out(out: Output) -> Step {
+    match out {
+        Output::TimeStamp { control, stamp } => Step::PdOut {
+            format: 0,
+            control: u16::from(control.0),
+            target: 0,
+            speed: 0,
+            stamp: stamp.0,
+        },
+        Output::ControlTarget {
+            control_word,
+            target,
+        } => Step::PdOut {
+            format: 1,
+            control: control_word,
+            target,
+            speed: 0,
+            stamp: 0,
+        },
+        Output::SpeedControlTarget {
+            target_speed,
+            control_word,
+            target,
+        } => Step::PdOut {
+            format: 2,
+            control: control_word,
+            target,
+            speed: target_speed,
+            stamp: 0,
+        },
+    }
+}
+
+/// An environment change in its protocol text form.
+fn env(change: Env) -> Step {
+    Step::Env {
+        env: change.to_string(),
+    }
+}
+
+fn step(role: Role, text: impl Into<String>, action: Step) -> StepDef {
     StepDef {
         role,
         text: text.into(),
@@ -144,13 +153,20 @@ impl<'a, 's> Gen<'a, 's> {
             .find(|p| p.id == format)
             .and_then(address);
         let writes_format = case.steps.iter().any(|s| match &s.action {
-            Action::Isdu(Request::Write {
+            Step::IsduWrite {
                 index, subindex, ..
-            }) => format_index == Some((*index, *subindex)),
+            } => format_index == Some((*index, *subindex)),
             _ => false,
         });
         if writes_format {
             reqs.push(FORMAT_SWITCH.to_owned());
+        }
+        for s in &case.steps {
+            if let Step::Env { env } = &s.action {
+                if let Err(e) = env_request(0, env) {
+                    self.errors.push(format!("{id}: step {:?}: {e}", s.text));
+                }
+            }
         }
         let mut requirements: Vec<String> = Vec::new();
         let mut level = Level::Informative;
@@ -272,7 +288,7 @@ impl<'a, 's> Gen<'a, 's> {
         Some(step(
             Role::Check,
             format!("ISDU read {id} ({})", p.name),
-            Action::Isdu(Request::Read { index, subindex }),
+            Step::IsduRead { index, subindex },
         ))
     }
 
@@ -294,11 +310,11 @@ impl<'a, 's> Gen<'a, 's> {
         Some(step(
             role,
             format!("ISDU write {id} ({}) = {value}", p.name),
-            Action::Isdu(Request::Write {
+            Step::IsduWrite {
                 index,
                 subindex,
                 data,
-            }),
+            },
         ))
     }
 
@@ -324,42 +340,47 @@ impl<'a, 's> Gen<'a, 's> {
         })
     }
 
-    fn control_bit(&mut self, name: &str) -> u16 {
-        let v = self
-            .family
-            .bitfield("control")
+    /// A `control` bitfield value or bit by name (3.3.2).
+    fn control_named(&mut self, name: &str) -> u16 {
+        let bitfield = self.family.bitfield("control");
+        let value = bitfield
+            .and_then(|b| b.values.iter().find(|v| v.name == name))
+            .and_then(|v| u16::try_from(v.value).ok());
+        let bit = bitfield
             .and_then(|b| b.bits.iter().find(|x| x.name == name))
             .and_then(|x| 1u16.checked_shl(x.bit));
-        v.unwrap_or_else(|| {
-            self.errors.push(format!("no control bit {name:?}"));
+        value.or(bit).unwrap_or_else(|| {
+            self.errors.push(format!(
+                "no control-word value or bit {name:?} in bitfield control"
+            ));
             0
         })
     }
 
-    fn f1(&self, control_word: u16, target: i64) -> Action {
-        Action::Out(Output::ControlTarget {
+    fn f1(&self, control_word: u16, target: i64) -> Step {
+        pd_out(Output::ControlTarget {
             control_word,
             target: i32::try_from(target).unwrap_or(0),
         })
     }
 
-    fn f2(&self, target_speed: i16, control_word: u16, target: i64) -> Action {
-        Action::Out(Output::SpeedControlTarget {
+    fn f2(&self, target_speed: i16, control_word: u16, target: i64) -> Step {
+        pd_out(Output::SpeedControlTarget {
             target_speed,
             control_word,
             target: i32::try_from(target).unwrap_or(0),
         })
     }
 
-    fn f0(&self, code: u8, stamp: Stamp) -> Action {
-        Action::Out(Output::TimeStamp {
+    fn f0(&self, code: u8, stamp: Stamp) -> Step {
+        pd_out(Output::TimeStamp {
             control: TsCode(code),
             stamp,
         })
     }
 
-    fn until(running: bool) -> Action {
-        Action::Until {
+    fn until(running: bool) -> Step {
+        Step::Until {
             running,
             max: RUN_MAX,
         }
@@ -405,7 +426,7 @@ impl<'a, 's> Gen<'a, 's> {
                     steps: vec![step(
                         Role::Check,
                         format!("ISDU read {index}.{subindex}"),
-                        Action::Isdu(Request::Read { index, subindex }),
+                        Step::IsduRead { index, subindex },
                     )],
                     tol: EXACT,
                     plot: false,
@@ -425,16 +446,16 @@ impl<'a, 's> Gen<'a, 's> {
                             step(
                                 Role::Check,
                                 format!("ISDU write {index}.{subindex} with {len} zero octet(s)"),
-                                Action::Isdu(Request::Write {
+                                Step::IsduWrite {
                                     index,
                                     subindex,
                                     data: vec![0; len],
-                                }),
+                                },
                             ),
                             step(
                                 Role::Check,
                                 "read back: unchanged",
-                                Action::Isdu(Request::Read { index, subindex }),
+                                Step::IsduRead { index, subindex },
                             ),
                         ],
                         tol: EXACT,
@@ -454,7 +475,7 @@ impl<'a, 's> Gen<'a, 's> {
                 vec![step(
                     Role::Check,
                     format!("ISDU read {index}.0"),
-                    Action::Isdu(Request::Read { index, subindex: 0 }),
+                    Step::IsduRead { index, subindex: 0 },
                 )],
             );
         }
@@ -513,20 +534,20 @@ impl<'a, 's> Gen<'a, 's> {
             let mut steps = vec![step(
                 Role::Check,
                 format!("ISDU write {} = {v}", p.id),
-                Action::Isdu(Request::Write {
+                Step::IsduWrite {
                     index,
                     subindex,
                     data,
-                }),
+                },
             )];
             if p.access.readable() {
                 steps.push(step(
                     Role::Check,
                     "read back",
-                    Action::Isdu(Request::Read { index, subindex }),
+                    Step::IsduRead { index, subindex },
                 ));
             }
-            steps.push(step(Role::Check, "two cycles", Action::Hold(2)));
+            steps.push(step(Role::Check, "two cycles", Step::Hold { cycles: 2 }));
             self.push(
                 format!("psx3xx/isdu/write/{}/{name}", p.id),
                 &reqs,
@@ -579,16 +600,16 @@ impl<'a, 's> Gen<'a, 's> {
                     step(
                         Role::Check,
                         format!("ISDU read {index}.0"),
-                        Action::Isdu(Request::Read { index, subindex: 0 }),
+                        Step::IsduRead { index, subindex: 0 },
                     ),
                     step(
                         Role::Check,
                         format!("ISDU write {index}.0 = 00 01"),
-                        Action::Isdu(Request::Write {
+                        Step::IsduWrite {
                             index,
                             subindex: 0,
                             data: vec![0, 1],
-                        }),
+                        },
                     ),
                 ],
             );
@@ -632,16 +653,16 @@ impl<'a, 's> Gen<'a, 's> {
                     step(
                         Role::Check,
                         format!("ISDU read {index}.{subindex}"),
-                        Action::Isdu(Request::Read { index, subindex }),
+                        Step::IsduRead { index, subindex },
                     ),
                     step(
                         Role::Check,
                         format!("ISDU write {index}.{subindex} = 00"),
-                        Action::Isdu(Request::Write {
+                        Step::IsduWrite {
                             index,
                             subindex,
                             data: vec![0],
-                        }),
+                        },
                     ),
                 ],
             );
@@ -688,16 +709,16 @@ impl<'a, 's> Gen<'a, 's> {
                         step(
                             Role::Check,
                             format!("ISDU write {index}.{subindex} with {} octet(s)", data.len()),
-                            Action::Isdu(Request::Write {
+                            Step::IsduWrite {
                                 index,
                                 subindex,
                                 data,
-                            }),
+                            },
                         ),
                         step(
                             Role::Check,
                             "read back: unchanged",
-                            Action::Isdu(Request::Read { index, subindex }),
+                            Step::IsduRead { index, subindex },
                         ),
                     ],
                 );
@@ -759,7 +780,7 @@ impl<'a, 's> Gen<'a, 's> {
                 self.write(Role::Check, &g.guard, g.suppress),
                 self.write(Role::Check, &g.guarded, new),
                 self.read(&g.guarded),
-                Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                Some(step(Role::Check, "two cycles", Step::Hold { cycles: 2 })),
             ]
             .into_iter()
             .flatten()
@@ -776,7 +797,7 @@ impl<'a, 's> Gen<'a, 's> {
             let allow: Vec<StepDef> = [
                 self.write(Role::Check, &g.guarded, new),
                 self.read(&g.guarded),
-                Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                Some(step(Role::Check, "two cycles", Step::Hold { cycles: 2 })),
             ]
             .into_iter()
             .flatten()
@@ -833,13 +854,11 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     "saving",
-                    Action::Hold(self.cycles_for(self.save_ms())),
+                    Step::Hold {
+                        cycles: self.cycles_for(self.save_ms()),
+                    },
                 )),
-                Some(step(
-                    Role::Check,
-                    "power cycle",
-                    Action::Env(Env::PowerCycle),
-                )),
+                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                 self.read(&g.guard),
             ]
             .into_iter()
@@ -903,12 +922,14 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     "saving or running",
-                    Action::Hold(save_cycles),
+                    Step::Hold {
+                        cycles: save_cycles,
+                    },
                 )),
                 Some(step(
                     Role::Check,
                     "until standstill",
-                    Action::Until {
+                    Step::Until {
                         running: false,
                         max: RUN_MAX,
                     },
@@ -929,11 +950,7 @@ impl<'a, 's> Gen<'a, 's> {
                 [
                     self.read(probe),
                     self.read(&format_param),
-                    Some(step(
-                        Role::Check,
-                        "power cycle",
-                        Action::Env(Env::PowerCycle),
-                    )),
+                    Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                     self.read(probe),
                     self.read(&format_param),
                 ]
@@ -987,7 +1004,7 @@ impl<'a, 's> Gen<'a, 's> {
             for v in values {
                 let steps: Vec<StepDef> = [
                     self.write(Role::Check, param, v),
-                    Some(step(Role::Check, "two cycles", Action::Hold(2))),
+                    Some(step(Role::Check, "two cycles", Step::Hold { cycles: 2 })),
                 ]
                 .into_iter()
                 .flatten()
@@ -1004,11 +1021,7 @@ impl<'a, 's> Gen<'a, 's> {
         let lost: Vec<StepDef> = [
             self.write(Role::Check, probe, probe_value),
             self.read(probe),
-            Some(step(
-                Role::Check,
-                "power cycle",
-                Action::Env(Env::PowerCycle),
-            )),
+            Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
             self.read(probe),
         ]
         .into_iter()
@@ -1024,13 +1037,15 @@ impl<'a, 's> Gen<'a, 's> {
             self.write(Role::Check, probe, probe_value),
             self.save(Role::Check),
             self.read(isdu::DELIVERY_STATE),
-            Some(step(Role::Check, "saving", Action::Hold(save_cycles))),
-            self.read(isdu::DELIVERY_STATE),
             Some(step(
                 Role::Check,
-                "power cycle",
-                Action::Env(Env::PowerCycle),
+                "saving",
+                Step::Hold {
+                    cycles: save_cycles,
+                },
             )),
+            self.read(isdu::DELIVERY_STATE),
+            Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
             self.read(probe),
         ]
         .into_iter()
@@ -1061,12 +1076,14 @@ impl<'a, 's> Gen<'a, 's> {
             let steps: Vec<StepDef> = [
                 self.write(Role::Check, &p.id, v),
                 self.save(Role::Check),
-                Some(step(Role::Check, "saving", Action::Hold(save_cycles))),
                 Some(step(
                     Role::Check,
-                    "power cycle",
-                    Action::Env(Env::PowerCycle),
+                    "saving",
+                    Step::Hold {
+                        cycles: save_cycles,
+                    },
                 )),
+                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                 self.read(&p.id),
             ]
             .into_iter()
@@ -1095,10 +1112,10 @@ impl<'a, 's> Gen<'a, 's> {
                 Some(step(
                     Role::Check,
                     format!("ISDU read {}.{subindex} ({})", dp.isdu_index, e.name),
-                    Action::Isdu(Request::Read {
+                    Step::IsduRead {
                         index: dp.isdu_index,
                         subindex,
-                    }),
+                    },
                 ))
             })
             .collect()
@@ -1125,7 +1142,13 @@ impl<'a, 's> Gen<'a, 's> {
         let mut steps: Vec<StepDef> = [
             self.write(role, &param, i64::from(format)),
             self.save(role),
-            Some(step(role, "saving", Action::Hold(save_cycles))),
+            Some(step(
+                role,
+                "saving",
+                Step::Hold {
+                    cycles: save_cycles,
+                },
+            )),
             self.write(role, &reset_param, reset_value),
         ]
         .into_iter()
@@ -1134,7 +1157,7 @@ impl<'a, 's> Gen<'a, 's> {
         steps.push(step(
             role,
             format!("format {format} idle output"),
-            Action::Out(self.idle(format)),
+            pd_out(self.idle(format)),
         ));
         steps
     }
@@ -1150,14 +1173,14 @@ impl<'a, 's> Gen<'a, 's> {
             steps.push(step(
                 Role::Check,
                 "cycles in the old format",
-                Action::Hold(2),
+                Step::Hold { cycles: 2 },
             ));
             steps.extend(self.device_id_reads());
             steps.extend(self.switch_to(f, Role::Check));
             steps.push(step(
                 Role::Check,
                 "cycles in the new format",
-                Action::Hold(2),
+                Step::Hold { cycles: 2 },
             ));
             steps.extend(self.device_id_reads());
             let mut reqs = vec![
@@ -1181,13 +1204,13 @@ impl<'a, 's> Gen<'a, 's> {
             );
             let unsaved: Vec<StepDef> = [
                 self.write(Role::Check, &param, i64::from(f)),
+                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
+                self.read(&param),
                 Some(step(
                     Role::Check,
-                    "power cycle",
-                    Action::Env(Env::PowerCycle),
+                    "cycles in format 1",
+                    Step::Hold { cycles: 2 },
                 )),
-                self.read(&param),
-                Some(step(Role::Check, "cycles in format 1", Action::Hold(2))),
             ]
             .into_iter()
             .flatten()
@@ -1269,7 +1292,7 @@ impl<'a, 's> Gen<'a, 's> {
                     self.f2(low, transfer, target),
                 )),
                 Some(step(Role::Check, "until running", Self::until(true))),
-                Some(step(Role::Check, "running", Action::Hold(20))),
+                Some(step(Role::Check, "running", Step::Hold { cycles: 20 })),
                 Some(step(
                     Role::Check,
                     format!("speed {fast} during the run"),
@@ -1295,7 +1318,7 @@ impl<'a, 's> Gen<'a, 's> {
                 format!("speed {bad} (above the range), 0x14 to start+8000"),
                 self.f2(bad, transfer, target),
             ),
-            step(Role::Check, "no run", Action::Hold(10)),
+            step(Role::Check, "no run", Step::Hold { cycles: 10 }),
             step(
                 Role::Check,
                 format!("speed {fast}: the run starts"),
@@ -1325,7 +1348,7 @@ impl<'a, 's> Gen<'a, 's> {
                 self.f2(low, manual, 0),
             ),
             step(Role::Check, "until running", Self::until(true)),
-            step(Role::Check, "manual run", Action::Hold(25)),
+            step(Role::Check, "manual run", Step::Hold { cycles: 25 }),
             step(Role::Check, "0x10: stop", self.f2(low, release, 0)),
             step(Role::Check, "until standstill", Self::until(false)),
         ]);
@@ -1407,10 +1430,10 @@ impl<'a, 's> Gen<'a, 's> {
             step(
                 Role::Check,
                 "the valid stamp repeated: nothing runs",
-                Action::Hold(30),
+                Step::Hold { cycles: 30 },
             ),
             step(Role::Check, "code 3, stamp 3000", self.f0(3, Stamp(3000))),
-            step(Role::Check, "still nothing", Action::Hold(10)),
+            step(Role::Check, "still nothing", Step::Hold { cycles: 10 }),
             step(Role::Check, "stamp inactive", self.f0(3, inactive)),
             step(Role::Check, "until running", Self::until(true)),
             step(Role::Check, "until standstill", Self::until(false)),
@@ -1432,7 +1455,7 @@ impl<'a, 's> Gen<'a, 's> {
                 ),
                 step(Role::Check, "stamp inactive", self.f0(code, inactive)),
                 step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(25)),
+                step(Role::Check, "manual run", Step::Hold { cycles: 25 }),
                 step(Role::Check, "code 0, stamp 0: cancel", self.f0(0, Stamp(0))),
                 step(Role::Check, "until standstill", Self::until(false)),
             ]);
@@ -1470,675 +1493,25 @@ impl<'a, 's> Gen<'a, 's> {
             steps,
         );
     }
+}
 
-    // ------------------------------------------------------------------ status
-
-    fn status_cases(&mut self) {
-        let start = self.value(isdu::ACTUAL);
-        let transfer = self.control("release-and-transfer");
-        let release = self.control("release");
-        let clear = self.control_bit("Clear error bits");
-        let manual_down = self.control("release-manual-run-smaller");
-        self.motion(
-            "status/power-on",
-            &["PSX-STS-LAYOUT", "PSX-STS-4-SET-1"],
-            "status word after power-on",
-            vec![step(Role::Check, "three cycles", Action::Hold(3))],
-        );
-        self.motion(
-            "status/target-reached",
-            &[
-                "PSX-STS-0-SET-1",
-                "PSX-STS-6-SET-1",
-                "PSX-STS-6-RESET-1",
-                "PSX-STS-0-RESET-1",
-            ],
-            "bit 6 while running, bit 0 at the target, bit 0 cleared by a new target",
-            vec![
-                step(
-                    Role::Check,
-                    "0x14 to start+2000",
-                    self.f1(transfer, start + 2000),
-                ),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "until standstill", Self::until(false)),
-                step(Role::Check, "0x14 to start", self.f1(transfer, start)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "status/release-withdrawn",
-            &[
-                "PSX-STS-5-SET-1",
-                "PSX-CMD-002",
-                "PSX-CTL-4-3",
-                "PSX-CTL-14-1",
-                "PSX-STS-5-RESET-2",
-            ],
-            "withdrawing the release cancels the run and sets bit 5; a bit 14 edge clears it",
-            vec![
-                step(
-                    Role::Check,
-                    "0x14 to start+20000",
-                    self.f1(transfer, start + 20_000),
-                ),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "running", Action::Hold(10)),
-                step(Role::Check, "0x00", self.f1(0, start + 20_000)),
-                step(Role::Check, "until standstill", Self::until(false)),
-                step(Role::Check, "bit 14 set", self.f1(clear, start + 20_000)),
-                step(Role::Check, "held", Action::Hold(3)),
-            ],
-        );
-        let umot = self.value(isdu::UMOT_LIMIT);
-        self.motion(
-            "status/motor-voltage",
-            &[
-                "PSX-STS-4-RESET-1",
-                "PSX-STS-13-SET-1",
-                "PSX-STS-4-SET-1",
-                "PSX-ISDU-181-BIT4",
-            ],
-            "motor voltage below ISDU 181: bit 4 cleared, a positioning order sets bit 13",
-            vec![
-                step(
-                    Role::Check,
-                    format!("motor voltage {} (0.1 V)", umot - 10),
-                    Action::Env(Env::MotorVoltage(u16::try_from(umot - 10).unwrap_or(0))),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(
-                    Role::Check,
-                    "0x14 to start+2000",
-                    self.f1(transfer, start + 2000),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(
-                    Role::Check,
-                    "motor voltage 240",
-                    Action::Env(Env::MotorVoltage(240)),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-            ],
-        );
-        let tmax = self.value(isdu::TEMPERATURE_LIMIT);
-        self.motion(
-            "status/temperature",
-            &["PSX-STS-7-SET-1", "PSX-STS-7-RESET-1", "PSX-ISDU-182-BIT7"],
-            "temperature above ISDU 182 sets bit 7; 5 °C below it clears it",
-            vec![
-                step(
-                    Role::Check,
-                    format!("temperature {} °C", tmax + 1),
-                    Action::Env(Env::Temperature(i16::try_from(tmax + 1).unwrap_or(0))),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(
-                    Role::Check,
-                    format!("temperature {} °C", tmax - 6),
-                    Action::Env(Env::Temperature(i16::try_from(tmax - 6).unwrap_or(0))),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-            ],
-        );
-        let window = self.value(isdu::WINDOW);
-        self.motion(
-            "status/displaced",
-            &["PSX-STS-11-SET-1", "PSX-STS-11-RESET-1", "PSX-ISDU-131-WINDOW"],
-            "turned by hand at standstill by more than ISDU 131: bit 11; a positioning order clears it",
-            vec![
-                step(Role::Check, "0x14 to start+2000", self.f1(transfer, start + 2000)),
-                step(Role::Check, "until standstill", Self::until(false)),
-                step(
-                    Role::Check,
-                    format!("displaced by {}", window + 50),
-                    Action::Env(Env::Displace(window + 50)),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(Role::Check, "0x14 to start", self.f1(transfer, start)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        let upper = self.value(&self.rules.protocol().mapping.upper_limit_param);
-        self.motion(
-            "status/target-outside",
-            &["PSX-STS-12-SET-1", "PSX-STS-12-RESET-1"],
-            "a target above ISDU 129 is refused with bit 12; a valid one clears it",
-            vec![
-                step(
-                    Role::Check,
-                    "0x14 to ISDU 129 + 10",
-                    self.f1(transfer, upper + 10),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(Role::Check, "0x10", self.f1(release, upper + 10)),
-                step(
-                    Role::Check,
-                    "0x14 to start+1000",
-                    self.f1(transfer, start + 1000),
-                ),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "status/manual-against-loop",
-            &["PSX-STS-8-SET-1", "PSX-CTL-1-1", "PSX-CMD-006"],
-            "a manual run against the loop direction sets bit 8",
-            vec![
-                step(Role::Check, "0x12", self.f1(manual_down, start)),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(20)),
-                step(Role::Check, "0x10: stop", self.f1(release, start)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "status/jog-keys",
-            &[
-                "PSX-STS-2-SET-1",
-                "PSX-STS-2-RESET-1",
-                "PSX-STS-3-SET-1",
-                "PSX-STS-3-RESET-1",
-            ],
-            "status bits 3 and 2 follow the forward and reverse jog keys",
-            vec![
-                step(
-                    Role::Check,
-                    "forward key",
-                    Action::Env(Env::Keys {
-                        forward: true,
-                        reverse: false,
-                    }),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(
-                    Role::Check,
-                    "both keys",
-                    Action::Env(Env::Keys {
-                        forward: true,
-                        reverse: true,
-                    }),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(
-                    Role::Check,
-                    "reverse key",
-                    Action::Env(Env::Keys {
-                        forward: false,
-                        reverse: true,
-                    }),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-                step(
-                    Role::Check,
-                    "no key",
-                    Action::Env(Env::Keys {
-                        forward: false,
-                        reverse: false,
-                    }),
-                ),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "status/obstruction",
-            &["PSX-STS-10-SET-1", "PSX-STS-10-RESET-1"],
-            "a jammed shaft during a run cancels it with bit 10; a new positioning order clears it",
-            vec![
-                step(
-                    Role::Check,
-                    "0x14 to start+20000",
-                    self.f1(transfer, start + 20_000),
-                ),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "jam", Action::Env(Env::Jam(true))),
-                step(Role::Check, "until standstill", Self::until(false)),
-                step(Role::Check, "cycles", Action::Hold(40)),
-                step(Role::Check, "free", Action::Env(Env::Jam(false))),
-                step(Role::Check, "0x10", self.f1(release, start)),
-                step(Role::Check, "0x14 to start", self.f1(transfer, start)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "status/position-fault",
-            &["PSX-STS-9-SET-1"],
-            "an internal position fault sets bit 9",
-            vec![
-                step(Role::Check, "cycles", Action::Hold(2)),
-                step(
-                    Role::Check,
-                    "position fault",
-                    Action::Env(Env::PositionFault),
-                ),
-                step(Role::Check, "cycles", Action::Hold(SETTLE)),
-            ],
-        );
-        // Manual runs to narrowed end limits (ISDU 129 / 130): bits 14 and 15.
-        let up = self.control("release-manual-run-larger");
-        let mapping = &self.rules.protocol().mapping;
-        let (upper_limit, lower_limit) = (
-            mapping.upper_limit_param.clone(),
-            mapping.lower_limit_param.clone(),
-        );
-        for (limit, offset, word, bit, name) in [
-            (upper_limit.as_str(), 600i64, up, "14", "upper"),
-            (lower_limit.as_str(), -600, manual_down, "15", "lower"),
-        ] {
-            let steps: Vec<StepDef> = [
-                self.write(Role::Setup, limit, start + offset),
-                Some(step(
-                    Role::Check,
-                    format!("{word:#06x}: manual run"),
-                    self.f1(word, start),
-                )),
-                Some(step(Role::Check, "until running", Self::until(true))),
-                Some(step(Role::Check, "until standstill", Self::until(false))),
-                Some(step(Role::Check, "held at the limit", Action::Hold(SETTLE))),
-                Some(step(
-                    Role::Check,
-                    "0x14 to start: bit cleared",
-                    self.f1(transfer, start),
-                )),
-                Some(step(Role::Check, "until standstill", Self::until(false))),
-            ]
-            .into_iter()
-            .flatten()
-            .collect();
-            let set = format!("PSX-STS-{bit}-SET-1");
-            let reset = format!("PSX-STS-{bit}-RESET-1");
-            self.motion(
-                &format!("status/{name}-limit"),
-                &[&set, &reset, "PSX-JOG-008"],
-                &format!(
-                    "a manual run stops at the {name} limit ISDU {limit} with bit {bit}; a positioning run clears it"
-                ),
-                steps,
-            );
-        }
-    }
-
-    // ------------------------------------------------------------------ timeout
-
-    fn timeout_cases(&mut self) {
-        let t = self.rules.protocol().timeout.clone();
-        let start = self.value(isdu::ACTUAL);
-        let transfer = self.control("release-and-transfer");
-        let far = start + 40_000;
-        let silence = 300_000;
-        let release = self.control("release");
-        let off: Vec<StepDef> = [
-            Some(step(
-                Role::Check,
-                "0x14 to start+40000",
-                self.f1(transfer, far),
-            )),
-            Some(step(Role::Check, "until running", Self::until(true))),
-            Some(step(
-                Role::Check,
-                "connection lost",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
-            )),
-            Some(step(
-                Role::Check,
-                "silence 300 ms",
-                Action::Silence(silence),
-            )),
-            self.read(isdu::ACTUAL),
-            Some(step(
-                Role::Check,
-                "connected",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
-            )),
-            Some(step(Role::Check, "until standstill", Self::until(false))),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        self.motion(
-            "timeout/off",
-            &["PSX-TIMEOUT-001", "PSX-TIMEOUT-002", "PSX-TIMEOUT-006"],
-            "ISDU 118 = 0: a run goes on while the connection is lost",
-            off,
-        );
-        for (config, name, reqs) in [
-            (1i64, "cancel", vec!["PSX-TIMEOUT-003", "PSX-TIMEOUT-004"]),
-            (
-                2,
-                "safe-position",
-                vec!["PSX-TIMEOUT-003", "PSX-TIMEOUT-005"],
-            ),
-        ] {
-            let steps: Vec<StepDef> = [
-                self.write(Role::Setup, &t.timeout_param, 100),
-                self.write(Role::Setup, &t.config_param, config),
-                self.write(Role::Setup, &t.safe_position_param, start - 5000),
-                Some(step(
-                    Role::Check,
-                    "0x14 to start+40000",
-                    self.f1(transfer, far),
-                )),
-                Some(step(Role::Check, "until running", Self::until(true))),
-                Some(step(
-                    Role::Check,
-                    "kept alive: cycles for 200 ms",
-                    Action::Hold(self.cycles_for(200)),
-                )),
-                Some(step(
-                    Role::Check,
-                    "silence 300 ms",
-                    Action::Silence(silence),
-                )),
-                self.read(isdu::STATUS),
-                Some(step(
-                    Role::Check,
-                    "silence 10 s",
-                    Action::Silence(10_000_000),
-                )),
-                self.read(isdu::STATUS),
-                self.read(isdu::ACTUAL),
-                Some(step(Role::Check, "0x10", self.f1(release, far))),
-                Some(step(Role::Check, "until standstill", Self::until(false))),
-            ]
-            .into_iter()
-            .flatten()
-            .collect();
-            self.motion(
-                &format!("timeout/{name}"),
-                &reqs,
-                &format!(
-                    "ISDU 118 = 100 ms, ISDU 137 = {config}: the master falls silent during a run"
-                ),
-                steps,
-            );
-        }
-        let reserved: Vec<StepDef> = [
-            self.write(Role::Check, &t.config_param, 0),
-            self.read(&t.config_param),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        self.case(
-            "timeout/reserved",
-            &["PSX-TIMEOUT-007", "PSX-ISDU-137-RANGE"],
-            "ISDU 137 = 0 is reserved: refused",
-            reserved,
-        );
-    }
-
-    // ------------------------------------------------------------------ position
-
-    fn position_cases(&mut self) {
-        let start = self.value(isdu::ACTUAL);
-        let transfer = self.control("release-and-transfer");
-        let without = self.control("run-without-loop");
-        let release = self.control("release");
-        let up = self.control("release-manual-run-larger");
-        let only_transfer = self.control("transfer-without-release");
-        for (name, offset, cw, reqs) in [
-            (
-                "loop-up",
-                5000i64,
-                transfer,
-                vec!["PSX-RUN-001", "PSX-RUN-002", "PSX-CMD-001"],
-            ),
-            (
-                "loop-down",
-                -5000,
-                transfer,
-                vec!["PSX-RUN-001", "PSX-RUN-003", "PSX-CMD-001"],
-            ),
-            (
-                "no-loop-down",
-                -5000,
-                transfer | without,
-                vec!["PSX-RUN-007", "PSX-CMD-008"],
-            ),
-            (
-                "no-loop-up",
-                5000,
-                transfer | without,
-                vec!["PSX-RUN-007", "PSX-CMD-008"],
-            ),
-        ] {
-            self.motion(
-                &format!("position/{name}"),
-                &reqs,
-                &format!("positioning by {offset} steps with control word {cw:#06x}"),
-                vec![
-                    step(
-                        Role::Check,
-                        format!("{cw:#06x} to start{offset:+}"),
-                        self.f1(cw, start + offset),
-                    ),
-                    step(Role::Check, "until running", Self::until(true)),
-                    step(Role::Check, "until standstill", Self::until(false)),
-                ],
-            );
-        }
-        self.motion(
-            "position/new-target",
-            &["PSX-CMD-003"],
-            "a new target during a run is approached at once",
-            vec![
-                step(
-                    Role::Check,
-                    "0x14 to start+20000",
-                    self.f1(transfer, start + 20_000),
-                ),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "running", Action::Hold(20)),
-                step(
-                    Role::Check,
-                    "0x14 to start+10000",
-                    self.f1(transfer, start + 10_000),
-                ),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "position/transfer-then-release",
-            &["PSX-CMD-005", "PSX-CMD-010", "PSX-CTL-2-1"],
-            "a target transferred without release starts when release is set",
-            vec![
-                step(
-                    Role::Check,
-                    "0x04 to start+3000",
-                    self.f1(only_transfer, start + 3000),
-                ),
-                step(Role::Check, "no run", Action::Hold(10)),
-                step(Role::Check, "0x10", self.f1(release, start + 3000)),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "position/manual",
-            &["PSX-CMD-006", "PSX-CTL-0-1"],
-            "0x11 runs to larger values until 0x10",
-            vec![
-                step(Role::Check, "0x11", self.f1(up, start)),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(25)),
-                step(Role::Check, "0x10", self.f1(release, start)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        self.motion(
-            "position/manual-then-target",
-            &["PSX-CMD-007", "PSX-CMD-004"],
-            "a target transferred during a manual run ends it and is approached at once",
-            vec![
-                step(Role::Check, "0x11", self.f1(up, start)),
-                step(Role::Check, "until running", Self::until(true)),
-                step(Role::Check, "manual run", Action::Hold(15)),
-                step(
-                    Role::Check,
-                    "0x14 to start+6000",
-                    self.f1(transfer, start + 6000),
-                ),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        let jog_key_release = self.control_bit("Release jog operation with keys");
-        let hold_ms = self
-            .value(isdu::JOG_WAIT)
-            .saturating_mul(5)
-            .saturating_add(200);
-        let hold = u64::try_from(hold_ms).unwrap_or(0);
-        self.motion(
-            "position/jog-step",
-            &["PSX-JOG-002", "PSX-JOG-005", "PSX-JOG-010"],
-            "with control bit 5 a short key press runs one jog step",
-            vec![
-                step(
-                    Role::Check,
-                    "control bit 5",
-                    self.f1(jog_key_release, start),
-                ),
-                step(
-                    Role::Check,
-                    "forward key",
-                    Action::Env(Env::Keys {
-                        forward: true,
-                        reverse: false,
-                    }),
-                ),
-                step(Role::Check, "cycles", Action::Hold(2)),
-                step(
-                    Role::Check,
-                    "released",
-                    Action::Env(Env::Keys {
-                        forward: false,
-                        reverse: false,
-                    }),
-                ),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        let continuous = self.control_bit("Release manual run in jog mode");
-        self.motion(
-            "position/jog-continuous",
-            &["PSX-JOG-006", "PSX-JOG-007", "PSX-JOG-009"],
-            "with control bits 5 and 3 a held key turns into a continuous run; both keys cancel it",
-            vec![
-                step(
-                    Role::Check,
-                    "control bits 5 and 3",
-                    self.f1(jog_key_release | continuous, start),
-                ),
-                step(
-                    Role::Check,
-                    "reverse key held",
-                    Action::Env(Env::Keys {
-                        forward: false,
-                        reverse: true,
-                    }),
-                ),
-                step(
-                    Role::Check,
-                    format!("held {hold} ms"),
-                    Action::Hold(self.cycles_for(hold)),
-                ),
-                step(
-                    Role::Check,
-                    "both keys",
-                    Action::Env(Env::Keys {
-                        forward: true,
-                        reverse: true,
-                    }),
-                ),
-                step(Role::Check, "until standstill", Self::until(false)),
-                step(
-                    Role::Check,
-                    "released",
-                    Action::Env(Env::Keys {
-                        forward: false,
-                        reverse: false,
-                    }),
-                ),
-                step(Role::Check, "cycles", Action::Hold(3)),
-            ],
-        );
-        let jog_bit = self.control_bit("Jog to larger values");
-        self.motion(
-            "position/jog-bit",
-            &["PSX-JOG-011", "PSX-JOG-005"],
-            "control bit 8 jogs like the forward key",
-            vec![
-                step(Role::Check, "control bit 8", self.f1(jog_bit, start)),
-                step(Role::Check, "cycles", Action::Hold(2)),
-                step(Role::Check, "0x00", self.f1(0, start)),
-                step(Role::Check, "until standstill", Self::until(false)),
-            ],
-        );
-        let key_hold = u64::from(self.cycles_for(hold)).saturating_mul(self.cycle_us);
-        let offline: Vec<StepDef> = [
-            Some(step(
-                Role::Check,
-                "connection lost",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Lost)),
-            )),
-            Some(step(
-                Role::Check,
-                "forward key held",
-                Action::Env(Env::Keys {
-                    forward: true,
-                    reverse: false,
-                }),
-            )),
-            Some(step(
-                Role::Check,
-                format!("held {hold} ms"),
-                Action::Silence(key_hold),
-            )),
-            Some(step(
-                Role::Check,
-                "released",
-                Action::Env(Env::Keys {
-                    forward: false,
-                    reverse: false,
-                }),
-            )),
-            Some(step(Role::Check, "silence 2 s", Action::Silence(2_000_000))),
-            Some(step(
-                Role::Check,
-                "connected",
-                Action::Env(Env::Link(drivespec_psd4xx::model::LinkEvent::Connected)),
-            )),
-            self.read(isdu::ACTUAL),
-            Some(step(Role::Check, "cycles", Action::Hold(3))),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        self.motion(
-            "position/jog-offline",
-            &["PSX-JOG-001", "PSX-JOG-006"],
-            "without IO-Link connection a held key jogs continuously",
-            offline,
-        );
-        let upper = self.value(&self.rules.protocol().mapping.upper_limit_param);
-        let steps: Vec<StepDef> = [
-            self.write(Role::Setup, isdu::LOOP_DIRECTION, 1),
-            Some(step(
-                Role::Check,
-                "0x14 to ISDU 129 with a backward loop",
-                self.f1(transfer, upper),
-            )),
-            Some(step(Role::Check, "refused", Action::Hold(SETTLE))),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
-        self.motion(
-            "position/limit-against-loop",
-            &["PSX-RUN-008", "PSX-STS-12-SET-1"],
-            "the upper limit cannot be reached with a backward loop: refused with bit 12",
-            steps,
-        );
-    }
+/// Why the PSx3xx cases cannot be generated from the spec.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub(crate) enum GenerateError {
+    /// The spec lacks what cases need: the first problem and how many there are.
+    #[error("{first} ({count} problem(s))")]
+    Spec {
+        /// The first problem.
+        first: String,
+        /// How many.
+        count: usize,
+    },
+    /// Two cases have the same id.
+    #[error("duplicate case id {id}")]
+    DuplicateId {
+        /// The id.
+        id: String,
+    },
 }
 
 /// Every case for `model`, in run order; `base` is the reference drive at power-on and
@@ -2148,7 +1521,7 @@ pub(crate) fn generate<'s>(
     model: &DeviceModel,
     base: &Drive<'s>,
     cycle_us: u64,
-) -> Result<(Vec<CaseInfo>, Vec<PsxCase>), String> {
+) -> Result<(Vec<CaseInfo>, Vec<PsxCase>), GenerateError> {
     let mut g = Gen {
         family,
         model,
@@ -2163,17 +1536,20 @@ pub(crate) fn generate<'s>(
     g.command_cases();
     g.format_cases();
     g.timestamp_cases();
-    g.status_cases();
-    g.timeout_cases();
-    g.position_cases();
+    g.scenario_cases();
     g.sequence_cases();
     if let Some(e) = g.errors.first() {
-        return Err(format!("{e} ({} problem(s))", g.errors.len()));
+        return Err(GenerateError::Spec {
+            first: e.clone(),
+            count: g.errors.len(),
+        });
     }
     let mut seen = std::collections::BTreeSet::new();
     for (info, _) in &g.out {
         if !seen.insert(info.id.clone()) {
-            return Err(format!("duplicate case id {}", info.id));
+            return Err(GenerateError::DuplicateId {
+                id: info.id.clone(),
+            });
         }
     }
     Ok(g.out.into_iter().unzip())

@@ -19,12 +19,13 @@ use crate::case::{CaseInfo, CaseRun, Role};
 use crate::cyclic::Peer;
 use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
 use crate::fuzz::replay::{Action, CyclicStep, Step};
-use crate::psx3xx::cases::{self as cases, PsxCase, StepDef, EXACT, MOTION};
+use crate::psx3xx::cases::{PsxCase, StepDef, EXACT, MOTION};
+use crate::psx3xx::session::output;
 use crate::psx3xx::{Psx3xx, Psx3xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
-use drivespec_psx3xx::isdu::Request as IsduRequest;
-use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
+use drivespec_psx3xx::step::Step as PsxStep;
+use drivespec_psx3xx::{Input, Output, Stamp};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Family, FamilyId, Level};
 use sequences::{PsxGen, ENV_KINDS};
@@ -159,25 +160,6 @@ fn idle(suite: &Psx3xxSuite<'_>, format: u8) -> Output {
     output(format, 0, 0, 0, inactive.0)
 }
 
-/// The process output of a `pd-out` step (manual 3.3.1).
-fn output(format: u8, control: u16, target: i32, speed: i16, stamp: u16) -> Output {
-    match format {
-        0 => Output::TimeStamp {
-            control: TsCode(u8::try_from(control).unwrap_or(u8::MAX)),
-            stamp: Stamp(stamp),
-        },
-        1 => Output::ControlTarget {
-            control_word: control,
-            target,
-        },
-        _ => Output::SpeedControlTarget {
-            target_speed: speed,
-            control_word: control,
-            target,
-        },
-    }
-}
-
 /// The signature names of the PSx3xx steps ([`cyclic_target::kind`] names the shared ones).
 fn own_kind(c: &CyclicStep) -> Option<String> {
     match c {
@@ -199,38 +181,46 @@ fn to_case_step(s: &Step) -> StepDef {
                 target,
                 speed,
                 stamp,
-            } => cases::Action::Out(output(*format, *control, *target, *speed, *stamp)),
-            CyclicStep::IsduRead { index, subindex } => cases::Action::Isdu(IsduRequest::Read {
+            } => PsxStep::PdOut {
+                format: *format,
+                control: *control,
+                target: *target,
+                speed: *speed,
+                stamp: *stamp,
+            },
+            CyclicStep::IsduRead { index, subindex } => PsxStep::IsduRead {
                 index: *index,
                 subindex: *subindex,
-            }),
+            },
             CyclicStep::IsduWrite {
                 index,
                 subindex,
                 data,
-            } => cases::Action::Isdu(IsduRequest::Write {
+            } => PsxStep::IsduWrite {
                 index: *index,
                 subindex: *subindex,
                 data: data.clone(),
-            }),
-            CyclicStep::Hold { cycles } => {
-                cases::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
-            }
-            CyclicStep::Until { running, max } => cases::Action::Until {
+            },
+            CyclicStep::Hold { cycles } => PsxStep::Hold {
+                cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
+            },
+            CyclicStep::Until { running, max } => PsxStep::Until {
                 running: *running,
                 max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
             },
-            CyclicStep::Env(env) => cases::Action::Env(*env),
-            CyclicStep::Advance { us } => {
-                cases::Action::Silence((*us).min(cyclic_target::MAX_ADVANCE_US))
-            }
+            CyclicStep::Env(env) => PsxStep::Env {
+                env: env.to_string(),
+            },
+            CyclicStep::Advance { us } => PsxStep::Advance {
+                us: (*us).min(cyclic_target::MAX_ADVANCE_US),
+            },
             CyclicStep::Process { .. }
             | CyclicStep::Offset { .. }
             | CyclicStep::Pkw { .. }
             | CyclicStep::RecordRead { .. }
-            | CyclicStep::RecordWrite { .. } => cases::Action::Hold(1),
+            | CyclicStep::RecordWrite { .. } => PsxStep::Hold { cycles: 1 },
         },
-        _ => cases::Action::Hold(1),
+        _ => PsxStep::Hold { cycles: 1 },
     };
     StepDef {
         role: Role::Check,

@@ -54,7 +54,7 @@ impl<'s> Psx3xxSuite<'s> {
         let reference = reference::psx3xx(spec, settings.model.as_deref())?;
         let cycle_us = min_cycle_us(&reference.drive)?;
         let (infos, cases) = cases::generate(family, reference.model, &reference.drive, cycle_us)
-            .map_err(SetupError::Spec)?;
+            .map_err(|e| SetupError::Spec(e.to_string()))?;
         Ok(Psx3xxSuite {
             family,
             reference,

@@ -1,13 +1,15 @@
 //! Running PSx3xx cases ([`crate::cyclic_session`]): every cycle's input image (status word
 //! exact) and every ISDU and injection reply is compared with the reference's.
 
-use super::cases::{Action, PsxCase, StepDef};
+use super::cases::{PsxCase, StepDef};
 use super::Psx3xxSuite;
 use crate::case::CaseInfo;
+use crate::cyclic::WireError;
 use crate::cyclic::{Reply, Request, Server};
 use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
-use drivespec_psx3xx::isdu::{ErrorType, Request as IsduRequest};
-use drivespec_psx3xx::{Input, Output};
+use drivespec_psx3xx::isdu::ErrorType;
+use drivespec_psx3xx::step::Step;
+use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
 use drivespec_spec::{DataType, Family, FamilyId};
 
 /// A session on one device under test.
@@ -155,7 +157,7 @@ impl<'a, 's> Psx3xx<'a, 's> {
 impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
     type Input = Input;
     type Output = Output;
-    type Action = Action;
+    type Action = Step;
     type Case = PsxCase;
     const ID: FamilyId = FamilyId::Psx3xx;
     const EXACT: &'static str = "status";
@@ -311,34 +313,77 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         }
     }
 
-    fn op(&self, action: &Action, _out: &Output, _last: Option<&Input>, t: u64) -> Op<Output> {
+    fn op(&self, action: &Step, _out: &Output, _last: Option<&Input>, t: u64) -> Op<Output> {
         match action {
-            Action::Out(out) => Op::Send { out: *out, max: 1 },
-            Action::Hold(k) => Op::Hold(*k),
-            Action::Until { running, max } => Op::Until {
+            Step::PdOut {
+                format,
+                control,
+                target,
+                speed,
+                stamp,
+            } => Op::Send {
+                out: output(*format, *control, *target, *speed, *stamp),
+                max: 1,
+            },
+            Step::Hold { cycles } => Op::Hold(*cycles),
+            Step::Until { running, max } => Op::Until {
                 running: *running,
                 max: *max,
             },
-            Action::Silence(us) => Op::Advance(*us),
-            Action::Isdu(r) => Op::Exchange(match r.clone() {
-                IsduRequest::Read { index, subindex } => Request::IsduRead { t, index, subindex },
-                IsduRequest::Write {
-                    index,
-                    subindex,
-                    data,
-                } => Request::IsduWrite {
-                    t,
-                    index,
-                    subindex,
-                    data,
-                },
+            Step::Advance { us } => Op::Advance(*us),
+            Step::IsduRead { index, subindex } => Op::Exchange(Request::IsduRead {
+                t,
+                index: *index,
+                subindex: *subindex,
             }),
-            Action::Env(env) => Op::Exchange(Request::Env { t, env: *env }),
+            Step::IsduWrite {
+                index,
+                subindex,
+                data,
+            } => Op::Exchange(Request::IsduWrite {
+                t,
+                index: *index,
+                subindex: *subindex,
+                data: data.clone(),
+            }),
+            // The suite builds no case whose environment text does not parse
+            // ([`env_request`]); such a step would cycle zero times.
+            Step::Env { env } => env_request(t, env).map_or(Op::Hold(0), Op::Exchange),
         }
     }
 
     /// Every output step is one cycle.
-    fn answered(&self, _action: &Action, _reference: &Input) -> bool {
+    fn answered(&self, _action: &Step, _reference: &Input) -> bool {
         true
+    }
+}
+
+/// The `ENV` request at `t` for an environment change in its text form (`jam 1`).
+pub(crate) fn env_request(t: u64, env: &str) -> Result<Request, WireError> {
+    match Request::parse(&format!("ENV {t} {env}"))? {
+        r @ Request::Env { .. } => Ok(r),
+        _ => Err(WireError {
+            line: env.to_owned(),
+            what: String::from("not an environment change"),
+        }),
+    }
+}
+
+/// The process output of a `pd-out` step (manual 3.3.1).
+pub(crate) fn output(format: u8, control: u16, target: i32, speed: i16, stamp: u16) -> Output {
+    match format {
+        0 => Output::TimeStamp {
+            control: TsCode(u8::try_from(control).unwrap_or(u8::MAX)),
+            stamp: Stamp(stamp),
+        },
+        1 => Output::ControlTarget {
+            control_word: control,
+            target,
+        },
+        _ => Output::SpeedControlTarget {
+            target_speed: speed,
+            control_word: control,
+            target,
+        },
     }
 }

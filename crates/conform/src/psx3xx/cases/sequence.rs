@@ -1,16 +1,16 @@
 //! Cases from the spec's PSx3xx `sequence` vectors (`spec/psx3xx/vectors`): each vector's
-//! start state and steps, read through the family [`Step`] type, become the inputs of one
+//! start state and steps, read through the family [`VectorStep`] type, become the inputs of one
 //! motion case; the device must show what the reference shows (manual 3.3, 4.4–4.6, 5.9–5.14).
 
-use super::{address, step, Action, Gen, PsxCase, StepDef, MOTION, SETTLE};
+use super::{address, env, pd_out, step, Gen, PsxCase, StepDef, MOTION, SETTLE};
 use crate::case::Role;
 use crate::cyclic::Env;
 use drivespec_positioner::script::kebab;
 use drivespec_positioner::step::read_sequence;
 use drivespec_psd4xx::model::LinkEvent;
-use drivespec_psx3xx::isdu::{Request, Value};
+use drivespec_psx3xx::isdu::Value;
 use drivespec_psx3xx::step::{
-    Event, IsduOp, IsduStep, Key, LoopSide, ProcessData, PsxSequence, Step,
+    Event, IsduOp, IsduStep, Key, LoopSide, ProcessData, PsxSequence, Step, VectorStep,
 };
 use drivespec_psx3xx::{Output, Stamp, TsCode};
 use drivespec_spec::{Vector, VectorKind};
@@ -122,7 +122,7 @@ impl Gen<'_, '_> {
             let n = n.saturating_add(1);
             self.sequence_step(&mut steps, n, s, format, loop_direction)?;
         }
-        steps.push(step(Role::Check, "settle", Action::Hold(SETTLE)));
+        steps.push(step(Role::Check, "settle", Step::Hold { cycles: SETTLE }));
         Some(steps)
     }
 
@@ -130,7 +130,7 @@ impl Gen<'_, '_> {
         &mut self,
         steps: &mut Vec<StepDef>,
         n: usize,
-        s: &Step,
+        s: &VectorStep,
         format: u8,
         loop_direction: i64,
     ) -> Option<()> {
@@ -144,14 +144,14 @@ impl Gen<'_, '_> {
             steps.push(step(
                 Role::Check,
                 format!("step {n}: keys {}", kebab(&key)),
-                Action::Env(Env::Keys { forward, reverse }),
+                env(Env::Keys { forward, reverse }),
             ));
         }
         if let Some(pd) = &s.pd {
             steps.push(step(
                 Role::Check,
                 format!("step {n}: process data"),
-                Action::Out(output(format, pd)),
+                pd_out(output(format, pd)),
             ));
         }
         if let Some(isdu) = &s.isdu {
@@ -161,7 +161,7 @@ impl Gen<'_, '_> {
             let text = format!("step {n}: {}", kebab(&e));
             match e {
                 Event::ObstructionDetected => {
-                    steps.push(step(Role::Check, text, Action::Env(Env::Jam(true))));
+                    steps.push(step(Role::Check, text, env(Env::Jam(true))));
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: until standstill"),
@@ -170,7 +170,7 @@ impl Gen<'_, '_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: obstruction removed"),
-                        Action::Env(Env::Jam(false)),
+                        env(Env::Jam(false)),
                     ));
                 }
                 Event::TargetReached | Event::TargetReachedInLoopDirection => {
@@ -183,7 +183,7 @@ impl Gen<'_, '_> {
                         Some(LoopSide::AgainstLoop) => -with,
                         _ => with,
                     };
-                    steps.push(step(Role::Check, text, Action::Env(Env::Displace(by))));
+                    steps.push(step(Role::Check, text, env(Env::Displace(by))));
                 }
                 Event::MotorVoltageOutOfRange | Event::MotorVoltageInRange => {
                     let dv = if e == Event::MotorVoltageInRange {
@@ -191,24 +191,24 @@ impl Gen<'_, '_> {
                     } else {
                         100
                     };
-                    steps.push(step(Role::Check, text, Action::Env(Env::MotorVoltage(dv))));
+                    steps.push(step(Role::Check, text, env(Env::MotorVoltage(dv))));
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: 1 s"),
-                        Action::Hold(self.cycles_for(1000)),
+                        Step::Hold {
+                            cycles: self.cycles_for(1000),
+                        },
                     ));
                 }
                 Event::ConnectionLost => {
-                    steps.push(step(
-                        Role::Check,
-                        text,
-                        Action::Env(Env::Link(LinkEvent::Lost)),
-                    ));
+                    steps.push(step(Role::Check, text, env(Env::Link(LinkEvent::Lost))));
                     let ms = s.after_ms.unwrap_or(0).saturating_add(16);
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: {ms} ms"),
-                        Action::Hold(self.cycles_for(ms)),
+                        Step::Hold {
+                            cycles: self.cycles_for(ms),
+                        },
                     ));
                 }
             }
@@ -222,13 +222,15 @@ impl Gen<'_, '_> {
         steps.push(step(
             Role::Check,
             format!("step {n}: {ms} ms"),
-            Action::Hold(self.cycles_for(ms)),
+            Step::Hold {
+                cycles: self.cycles_for(ms),
+            },
         ));
         if s.key.is_some_and(|k| k != Key::None) && s.hold_ms.is_some() {
             steps.push(step(
                 Role::Check,
                 format!("step {n}: keys released"),
-                Action::Env(Env::Keys {
+                env(Env::Keys {
                     forward: false,
                     reverse: false,
                 }),
@@ -246,12 +248,12 @@ impl Gen<'_, '_> {
     fn isdu_step(&self, role: Role, at: &str, isdu: &IsduStep) -> Option<StepDef> {
         let (index, subindex) = (isdu.index, isdu.subindex);
         let request = match isdu.op {
-            IsduOp::Read => Request::Read { index, subindex },
+            IsduOp::Read => Step::IsduRead { index, subindex },
             IsduOp::Write => {
                 let value = isdu.value.unwrap_or(0);
                 let target = self.rules.isdu_target(index, subindex).ok()?;
                 let data = self.rules.encode_value(&target, &Value::Int(value)).ok()?;
-                Request::Write {
+                Step::IsduWrite {
                     index,
                     subindex,
                     data,
@@ -268,7 +270,7 @@ impl Gen<'_, '_> {
             (IsduOp::Write, Some(v)) => format!("{at}: ISDU write {index}.{subindex}{name} = {v}"),
             _ => format!("{at}: ISDU {} {index}.{subindex}{name}", kebab(&isdu.op)),
         };
-        Some(step(role, text, Action::Isdu(request)))
+        Some(step(role, text, request))
     }
 }
 
