@@ -86,6 +86,10 @@ pub struct LinkPeer {
 /// Longest reply line accepted.
 const MAX_LINE: usize = 4096;
 
+/// Longest wait for the answer to `HELLO`, µs: a device process may take this long to start
+/// on a loaded machine.
+const START_US: Micros = 15_000_000;
+
 impl LinkPeer {
     /// A peer over `link`; each reply is awaited at most `timeout_us`.
     pub fn new(link: Box<dyn Link>, timeout_us: Micros) -> LinkPeer {
@@ -120,7 +124,11 @@ impl Peer for LinkPeer {
         let mut line = text.clone().into_bytes();
         line.push(b'\n');
         self.link.send(&line)?;
-        let deadline = self.link.now().saturating_add(self.timeout_us);
+        let timeout_us = match req {
+            Request::Hello { .. } => self.timeout_us.max(START_US),
+            _ => self.timeout_us,
+        };
+        let deadline = self.link.now().saturating_add(timeout_us);
         loop {
             if let Some(l) = self.take_line() {
                 return Reply::parse(&l).map_err(|e| PeerError::Garbage {
@@ -137,7 +145,7 @@ impl Peer for LinkPeer {
             if self.link.now() >= deadline {
                 return Err(PeerError::Timeout {
                     request: text,
-                    ms: self.timeout_us / 1000,
+                    ms: timeout_us / 1000,
                     partial: String::from_utf8_lossy(&self.buf).into_owned(),
                 });
             }
