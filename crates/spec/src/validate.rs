@@ -594,21 +594,6 @@ fn is_requirement_id(id: &str, prefix: &str) -> bool {
         })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn requirement_ids() {
-        assert!(is_requirement_id("PSD-STS-10-RESET", "PSD"));
-        assert!(is_requirement_id("HPD-FRAME-004", "HPD"));
-        assert!(!is_requirement_id("HPD-FRAME", "HPD"));
-        assert!(!is_requirement_id("PSD-FRAME-004", "HPD"));
-        assert!(!is_requirement_id("HPD-frame-004", "HPD"));
-        assert!(!is_requirement_id("HPD--004", "HPD"));
-    }
-}
-
 /// What a rule naming a requirement that an earlier rule created must not say: another
 /// level, or the requirement's statement, source, parameters or note.
 fn restated(rule: &crate::BitRule, level: Level) -> Option<String> {
@@ -629,4 +614,19 @@ fn restated(rule: &crate::BitRule, level: Level) -> Option<String> {
     keys.iter().find(|(_, set)| *set).map(|(key, _)| {
         format!("`{key}` for requirement {id:?}, which an earlier rule already states")
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requirement_ids() {
+        assert!(is_requirement_id("PSD-STS-10-RESET", "PSD"));
+        assert!(is_requirement_id("HPD-FRAME-004", "HPD"));
+        assert!(!is_requirement_id("HPD-FRAME", "HPD"));
+        assert!(!is_requirement_id("PSD-FRAME-004", "HPD"));
+        assert!(!is_requirement_id("HPD-frame-004", "HPD"));
+        assert!(!is_requirement_id("HPD--004", "HPD"));
+    }
 }
