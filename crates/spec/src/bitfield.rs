@@ -1,5 +1,6 @@
 //! `[[bitfield]]` records: status and control words, HPD bit parameters, and their rules.
 
+use crate::{Level, Requirement};
 use serde::{Deserialize, Serialize};
 
 /// Whether a rule sets or resets its bit.
@@ -26,10 +27,52 @@ pub struct BitRule {
     /// Bits this one wins against when both would be set.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub priority_over: Vec<u32>,
-    /// The requirement this rule states.
+    /// The requirement this rule states; the first rule naming it creates its record.
     pub requirement: String,
+    /// Level of the requirement.
+    pub level: Level,
     /// The rule in words.
     pub text: String,
+    /// The requirement's text when it is not
+    /// `<bitfield id> bit <n> is <action>: <text> (<condition>)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub statement: Option<String>,
+    /// The requirement's manual section when it is not `<bitfield section> bit <n>`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<String>,
+    /// Parameters the requirement concerns.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub params: Vec<String>,
+    /// Remark on the requirement.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+impl BitRule {
+    /// `<bitfield id> bit <n> is <action>: <text>`, with ` (<condition>)` when there is one.
+    fn composed(&self, b: &Bitfield, bit: &BitfieldBit) -> String {
+        let text = format!(
+            "{} bit {} is {}: {}",
+            b.id,
+            bit.bit,
+            self.action.as_str(),
+            self.text
+        );
+        match &self.condition {
+            Some(c) => format!("{text} ({c})"),
+            None => text,
+        }
+    }
+}
+
+impl RuleAction {
+    /// The word used in spec files and requirement texts.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RuleAction::Set => "set",
+            RuleAction::Reset => "reset",
+        }
+    }
 }
 
 /// One bit of a bitfield.
@@ -124,4 +167,47 @@ impl Bitfield {
             .map(|b| b.name.as_str())
             .collect()
     }
+}
+
+impl Bitfield {
+    /// The manual section of the bits: the first part of `source` that is a bare section
+    /// number (`3.4` in `3.1 ISDU 64; 3.4`).
+    fn section(&self) -> &str {
+        self.source
+            .split(';')
+            .map(str::trim)
+            .find(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_digit() || c == '.'))
+            .unwrap_or(self.source.as_str())
+    }
+}
+
+/// The requirement records the rules of `bitfields` state, in rule order; the first rule
+/// naming a requirement creates it.
+pub(crate) fn rule_requirements(bitfields: &[Bitfield]) -> Vec<Requirement> {
+    let mut out: Vec<Requirement> = Vec::new();
+    for b in bitfields {
+        for bit in &b.bits {
+            for rule in &bit.rules {
+                if out.iter().any(|r| r.id == rule.requirement) {
+                    continue;
+                }
+                out.push(Requirement {
+                    id: rule.requirement.clone(),
+                    level: rule.level,
+                    text: rule
+                        .statement
+                        .clone()
+                        .unwrap_or_else(|| rule.composed(b, bit)),
+                    source: rule
+                        .source
+                        .clone()
+                        .unwrap_or_else(|| format!("{} bit {}", b.section(), bit.bit)),
+                    params: rule.params.clone(),
+                    note: rule.note.clone(),
+                    file: b.file.clone(),
+                });
+            }
+        }
+    }
+    out
 }

@@ -94,7 +94,7 @@ pub struct Family {
     pub models: Vec<DeviceModel>,
     /// Bitfields with their rules.
     pub bitfields: Vec<Bitfield>,
-    /// Normative statements.
+    /// Normative statements: those the bit rules state first, in rule order, then the records.
     pub requirements: Vec<Requirement>,
     /// Contradictions in the manual and the readings adopted.
     pub errata: Vec<Erratum>,

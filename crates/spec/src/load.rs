@@ -126,6 +126,7 @@ fn load_family(files: &SpecFiles, id: FamilyId, problems: &mut Vec<Problem>) -> 
         ));
     }
     crate::model_values::complete(&mut models, &param_sets, &parameters, problems);
+    requirements.splice(0..0, crate::bitfield::rule_requirements(&bitfields));
     Some(Family {
         info: info?,
         parameters,

@@ -1,7 +1,7 @@
 //! Consistency rules over a loaded spec (see `spec/SCHEMA.md`, "The loader rejects …").
 
 use crate::error::{Problem, ProblemKind};
-use crate::{Family, Parameter, Spec};
+use crate::{Family, Level, Parameter, Spec};
 use std::collections::BTreeMap;
 
 /// Every rule violated by the spec, in family and file order.
@@ -336,6 +336,7 @@ impl Validator<'_> {
 
     fn bitfields(&mut self) {
         let f = self.family;
+        let mut stated: Vec<(&str, Level)> = Vec::new();
         for b in &f.bitfields {
             let rec = format!("bitfield {:?}", b.id);
             if f.parameter(&b.param).is_none() {
@@ -375,8 +376,13 @@ impl Validator<'_> {
                 }
                 seen.push(bit.bit);
                 for rule in &bit.rules {
-                    if f.requirement(&rule.requirement).is_none() {
-                        self.dangling(&b.file, brec.clone(), "requirement", &rule.requirement);
+                    match stated.iter().find(|(id, _)| *id == rule.requirement) {
+                        Some((_, level)) => {
+                            if let Some(message) = restated(rule, *level) {
+                                self.push(&b.file, brec.clone(), ProblemKind::Invalid { message });
+                            }
+                        }
+                        None => stated.push((rule.requirement.as_str(), rule.level)),
                     }
                     if !is_token(&rule.trigger) {
                         self.push(
@@ -586,6 +592,28 @@ fn is_requirement_id(id: &str, prefix: &str) -> bool {
                 && p.chars()
                     .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
         })
+}
+
+/// What a rule naming a requirement that an earlier rule created must not say: another
+/// level, or the requirement's statement, source, parameters or note.
+fn restated(rule: &crate::BitRule, level: Level) -> Option<String> {
+    let id = &rule.requirement;
+    if rule.level != level {
+        return Some(format!(
+            "level {} for requirement {id:?}, which an earlier rule gives level {}",
+            rule.level.as_str(),
+            level.as_str()
+        ));
+    }
+    let keys = [
+        ("statement", rule.statement.is_some()),
+        ("source", rule.source.is_some()),
+        ("params", !rule.params.is_empty()),
+        ("note", rule.note.is_some()),
+    ];
+    keys.iter().find(|(_, set)| *set).map(|(key, _)| {
+        format!("`{key}` for requirement {id:?}, which an earlier rule already states")
+    })
 }
 
 #[cfg(test)]

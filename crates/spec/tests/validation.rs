@@ -252,20 +252,21 @@ name = "Target position reached"
 action = "set"
 trigger = "target-reached"
 requirement = "PSD-PAR-044"
+level = "must"
 text = "a target has been reached"
 "#;
 
 #[test]
 fn bitfield_sample_is_valid() {
     assert_eq!(
-        problems_with("psd4xx/test.toml", &format!("{PARAM}{REQ}{BITS}")),
+        problems_with("psd4xx/test.toml", &format!("{PARAM}{BITS}")),
         Vec::<String>::new()
     );
 }
 
 #[test]
 fn bitfield_parameter_must_exist() {
-    let p = one_problem(&format!("{REQ}{BITS}"));
+    let p = one_problem(BITS);
     assert_eq!(
         p,
         r#"psd4xx/test.toml: bitfield "status": parameter "44" does not exist"#
@@ -274,10 +275,7 @@ fn bitfield_parameter_must_exist() {
 
 #[test]
 fn bit_must_lie_inside_the_width() {
-    let p = one_problem(&format!(
-        "{PARAM}{REQ}{}",
-        BITS.replace("bit = 0", "bit = 16")
-    ));
+    let p = one_problem(&format!("{PARAM}{}", BITS.replace("bit = 0", "bit = 16")));
     assert_eq!(
         p,
         r#"psd4xx/test.toml: bitfield "status" bit 16: bit 16 outside width 16"#
@@ -285,18 +283,71 @@ fn bit_must_lie_inside_the_width() {
 }
 
 #[test]
-fn bit_rule_requirement_must_exist() {
-    let p = one_problem(&format!("{PARAM}{BITS}"));
+fn bit_rule_creates_its_requirement() {
+    let mut files = skeleton();
+    files.set("psd4xx/test.toml", &format!("{PARAM}{BITS}"));
+    let spec = Spec::from_files(&files).unwrap();
+    let r = spec
+        .family(drivespec_spec::FamilyId::Psd4xx)
+        .requirement("PSD-PAR-044")
+        .unwrap();
+    assert_eq!(
+        (r.level, r.text.as_str(), r.source.as_str(), r.file.as_str()),
+        (
+            drivespec_spec::Level::Must,
+            "status bit 0 is set: a target has been reached",
+            "3.6 bit 0",
+            "psd4xx/test.toml"
+        )
+    );
+}
+
+#[test]
+fn bit_rule_needs_a_level() {
+    let p = one_problem(&format!(
+        "{PARAM}{}",
+        BITS.replace("level = \"must\"\n", "")
+    ));
     assert_eq!(
         p,
-        r#"psd4xx/test.toml: bitfield "status" bit 0: requirement "PSD-PAR-044" does not exist"#
+        r#"psd4xx/test.toml: bitfield "status": missing field `level`"#
+    );
+}
+
+#[test]
+fn requirement_record_repeating_a_bit_rule_is_a_duplicate() {
+    let mut files = skeleton();
+    files.set("psd4xx/bits.toml", &format!("{PARAM}{BITS}"));
+    files.set("psd4xx/requirements-params.toml", REQ);
+    let problems: Vec<String> = match Spec::from_files(&files) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.0.iter().map(ToString::to_string).collect(),
+    };
+    assert_eq!(problems, vec![r#"psd4xx/requirements-params.toml: requirement "PSD-PAR-044": duplicate requirement id "PSD-PAR-044" (first in psd4xx/bits.toml)"#.to_owned()]);
+}
+
+#[test]
+fn later_rule_of_a_requirement_must_not_restate_it() {
+    let second = "\n[[bitfield.bit.rule]]\naction = \"reset\"\ntrigger = \"target-left\"\nrequirement = \"PSD-PAR-044\"\nlevel = \"should\"\ntext = \"the target is left\"\n";
+    let p = one_problem(&format!("{PARAM}{BITS}{second}"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status" bit 0: level should for requirement "PSD-PAR-044", which an earlier rule gives level must"#
+    );
+    let p = one_problem(&format!(
+        "{PARAM}{BITS}{}",
+        second.replace("should", "must") + "note = \"again\"\n"
+    ));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: bitfield "status" bit 0: `note` for requirement "PSD-PAR-044", which an earlier rule already states"#
     );
 }
 
 #[test]
 fn bit_rule_trigger_must_be_a_token() {
     let p = one_problem(&format!(
-        "{PARAM}{REQ}{}",
+        "{PARAM}{}",
         BITS.replace("target-reached", "Target reached")
     ));
     assert_eq!(
@@ -311,7 +362,7 @@ fn bit_priority_must_name_an_existing_bit() {
         "trigger = \"target-reached\"",
         "trigger = \"target-reached\"\npriority_over = [10]",
     );
-    let p = one_problem(&format!("{PARAM}{REQ}{bits}"));
+    let p = one_problem(&format!("{PARAM}{bits}"));
     assert_eq!(
         p,
         r#"psd4xx/test.toml: bitfield "status" bit 0: bit "10" does not exist"#
