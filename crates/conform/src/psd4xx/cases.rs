@@ -6,53 +6,16 @@ use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
 use drivespec_positioner::script::kebab;
 use drivespec_positioner::step::{read_sequence, StateValue, Wait};
-use drivespec_psd4xx::model::{Drive, LinkEvent, RecordRequest};
-use drivespec_psd4xx::step::{Direction, Event, PsdSequence};
+use drivespec_psd4xx::model::{Drive, LinkEvent};
+use drivespec_psd4xx::step::{Direction, Event, PsdSequence, Step};
 use drivespec_psd4xx::{PkwRequest, PkwRules, RecordWrite, Request, Rules, Width};
 use drivespec_spec::{Access, DeviceModel, Family, FamilyId, Level, Parameter, VectorKind};
-
-/// One action of a case; both the device and the reference get exactly the same inputs.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Action {
-    /// New process data (absent: unchanged), then one cycle.
-    Process {
-        /// Control word.
-        control: Option<u16>,
-        /// Target value.
-        target: Option<i32>,
-    },
-    /// A PKW block; cycles until the reference answers it (at most [`PKW_MAX_CYCLES`]).
-    Pkw(PkwRequest),
-    /// New control word (absent: unchanged) and a target relative to the reference's actual
-    /// position, then one cycle.
-    Offset {
-        /// Control word.
-        control: Option<u16>,
-        /// Target minus actual position.
-        offset: i64,
-    },
-    /// Cycles with the outputs unchanged.
-    Hold(u32),
-    /// Cycles until the reference is running (`true`) or at standstill (`false`).
-    Until {
-        /// Wait for status bit "drive is running" set (true) or clear (false).
-        running: bool,
-        /// Most cycles.
-        max: u32,
-    },
-    /// An acyclic record.
-    Record(RecordRequest),
-    /// An environment injection.
-    Env(Env),
-    /// Time passes by this many µs without a bus cycle (`ADVANCE`).
-    Advance(u64),
-}
 
 /// Most cycles a PKW command is repeated before the case moves on (PSD-PKW-002).
 pub(crate) const PKW_MAX_CYCLES: u32 = 8;
 
 /// One step of a case.
-pub(crate) type StepDef = crate::cyclic_session::StepDef<Action>;
+pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
 
 pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
 
@@ -101,7 +64,7 @@ pub(crate) fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
         .ok_or_else(|| format!("no control bit {name:?}"))
 }
 
-fn step(role: Role, text: impl Into<String>, action: Action) -> StepDef {
+fn step(role: Role, text: impl Into<String>, action: Step) -> StepDef {
     StepDef {
         role,
         text: text.into(),
@@ -156,14 +119,18 @@ impl Gen<'_> {
     fn exchange(&mut self, steps: &mut Vec<StepDef>, role: Role, text: &str, r: Request) {
         let req = self.request(r);
         let none = self.none();
-        steps.push(step(role, text, Action::Pkw(req)));
+        steps.push(step(role, text, Step::Pkw { pkw: req.into() }));
         steps.push(step(
             role,
             "command repeated: the response is held",
-            Action::Hold(3),
+            Step::Hold { cycles: 3 },
         ));
-        steps.push(step(role, "no command: no response", Action::Pkw(none)));
-        steps.push(step(role, "no response held", Action::Hold(2)));
+        steps.push(step(
+            role,
+            "no command: no response",
+            Step::Pkw { pkw: none.into() },
+        ));
+        steps.push(step(role, "no response held", Step::Hold { cycles: 2 }));
     }
 
     fn range(&self, p: &Parameter) -> Option<(i64, i64)> {
@@ -437,8 +404,8 @@ impl Gen<'_> {
             "command 0 is answered with response 0".to_owned(),
             PsdCase {
                 steps: vec![
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                    step(Role::Check, "hold", Action::Hold(3)),
+                    step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
+                    step(Role::Check, "hold", Step::Hold { cycles: 3 }),
                 ],
                 tol: EXCHANGE,
                 plot: false,
@@ -456,14 +423,14 @@ impl Gen<'_> {
             "a read of the actual position during a run keeps its value while the command is repeated".to_owned(),
             PsdCase {
                 steps: vec![
-                    step(Role::Setup, "0x14 to 400000", Action::Process { control: Some(rt), target: Some(400_000) }),
-                    step(Role::Setup, "until running", Action::Until { running: true, max: 200 }),
-                    step(Role::Setup, "run a while", Action::Hold(20)),
-                    step(Role::Check, "read par 3", Action::Pkw(read3)),
-                    step(Role::Check, "repeat: value held", Action::Hold(20)),
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                    step(Role::Check, "read par 3 again: a new value", Action::Pkw(read3)),
-                    step(Role::Check, "repeat", Action::Hold(5)),
+                    step(Role::Setup, "0x14 to 400000", Step::Process { control: Some(rt), target: Some(400_000) }),
+                    step(Role::Setup, "until running", Step::Until { running: true, max: 200 }),
+                    step(Role::Setup, "run a while", Step::Hold { cycles: 20 }),
+                    step(Role::Check, "read par 3", Step::Pkw { pkw: read3.into() }),
+                    step(Role::Check, "repeat: value held", Step::Hold { cycles: 20 }),
+                    step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
+                    step(Role::Check, "read par 3 again: a new value", Step::Pkw { pkw: read3.into() }),
+                    step(Role::Check, "repeat", Step::Hold { cycles: 5 }),
                 ],
                 tol: EXCHANGE,
                 plot: false,
@@ -481,11 +448,11 @@ impl Gen<'_> {
             "repeating a read without command 0 keeps the old answer; after command 0 the new value comes".to_owned(),
             PsdCase {
                 steps: vec![
-                    step(Role::Check, "read par 44", Action::Pkw(read44)),
-                    step(Role::Setup, "record write par 44 = 7", Action::Record(w44)),
-                    step(Role::Check, "repeat the read: old answer held", Action::Hold(4)),
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                    step(Role::Check, "read par 44: 7", Action::Pkw(read44)),
+                    step(Role::Check, "read par 44", Step::Pkw { pkw: read44.into() }),
+                    step(Role::Setup, "record write par 44 = 7", w44),
+                    step(Role::Check, "repeat the read: old answer held", Step::Hold { cycles: 4 }),
+                    step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
+                    step(Role::Check, "read par 44: 7", Step::Pkw { pkw: read44.into() }),
                 ],
                 tol: EXCHANGE,
                 plot: false,
@@ -502,9 +469,13 @@ impl Gen<'_> {
             "an array read of the scalar par 44: error 4".to_owned(),
             PsdCase {
                 steps: vec![
-                    step(Role::Check, "array read of par 44", Action::Pkw(arr)),
-                    step(Role::Check, "hold", Action::Hold(2)),
-                    step(Role::Check, "no command", Action::Pkw(none)),
+                    step(
+                        Role::Check,
+                        "array read of par 44",
+                        Step::Pkw { pkw: arr.into() },
+                    ),
+                    step(Role::Check, "hold", Step::Hold { cycles: 2 }),
+                    step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
                 ],
                 tol: EXCHANGE,
                 plot: false,
@@ -528,9 +499,13 @@ impl Gen<'_> {
                 format!("command code {} (not in the table): error 18", u8::from(ak)),
                 PsdCase {
                     steps: vec![
-                        step(Role::Check, "undefined command on par 44", Action::Pkw(req)),
-                        step(Role::Check, "hold", Action::Hold(2)),
-                        step(Role::Check, "no command", Action::Pkw(none)),
+                        step(
+                            Role::Check,
+                            "undefined command on par 44",
+                            Step::Pkw { pkw: req.into() },
+                        ),
+                        step(Role::Check, "hold", Step::Hold { cycles: 2 }),
+                        step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
                     ],
                     tol: EXCHANGE,
                     plot: false,
@@ -560,7 +535,7 @@ impl Gen<'_> {
                             step(
                                 Role::Setup,
                                 "0x14 to 400000",
-                                Action::Process {
+                                Step::Process {
                                     control: Some(rt),
                                     target: Some(400_000),
                                 },
@@ -568,14 +543,14 @@ impl Gen<'_> {
                             step(
                                 Role::Setup,
                                 "until running",
-                                Action::Until {
+                                Step::Until {
                                     running: true,
                                     max: 200,
                                 },
                             ),
-                            step(Role::Check, "write par 45", Action::Pkw(req)),
-                            step(Role::Check, "hold", Action::Hold(2)),
-                            step(Role::Check, "no command", Action::Pkw(none)),
+                            step(Role::Check, "write par 45", Step::Pkw { pkw: req.into() }),
+                            step(Role::Check, "hold", Step::Hold { cycles: 2 }),
+                            step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
                         ],
                         tol: EXCHANGE,
                         plot: false,
@@ -586,7 +561,7 @@ impl Gen<'_> {
         Ok(())
     }
 
-    fn record_write(&self, index: u16, control: u8, value: i64) -> Result<RecordRequest, String> {
+    fn record_write(&self, index: u16, control: u8, value: i64) -> Result<Step, String> {
         let p = self
             .family
             .parameters
@@ -603,7 +578,7 @@ impl Gen<'_> {
         }
         .to_bytes(rules)
         .map_err(|e| format!("record write {index}: {e}"))?;
-        Ok(RecordRequest::Write { index, data })
+        Ok(Step::RecordWrite { index, hex: data })
     }
 }
 
@@ -640,7 +615,7 @@ impl Gen<'_> {
                     steps: vec![step(
                         Role::Check,
                         format!("read record {num}"),
-                        Action::Record(RecordRequest::Read { index }),
+                        Step::RecordRead { index },
                     )],
                     tol: EXCHANGE,
                     plot: false,
@@ -657,11 +632,7 @@ impl Gen<'_> {
                     &["PSD-REC-001", "PSD-PAR-READONLY-001"],
                     format!("record write to the read-only par {num}: refused"),
                     PsdCase {
-                        steps: vec![step(
-                            Role::Check,
-                            format!("write record {num}"),
-                            Action::Record(w),
-                        )],
+                        steps: vec![step(Role::Check, format!("write record {num}"), w)],
                         tol: EXCHANGE,
                         plot: false,
                     },
@@ -676,7 +647,7 @@ impl Gen<'_> {
             } else {
                 "PSD-REC-007"
             };
-            let read = Action::Record(RecordRequest::Read { index });
+            let read = Step::RecordRead { index };
             let w = self.record_write(index, execute, min)?;
             self.push(
                 format!("psd4xx/record/write/{num}/execute"),
@@ -684,11 +655,7 @@ impl Gen<'_> {
                 format!("record write par {num} = {min} with control byte {execute}, read back"),
                 PsdCase {
                     steps: vec![
-                        step(
-                            Role::Check,
-                            format!("write record {num} = {min}"),
-                            Action::Record(w),
-                        ),
+                        step(Role::Check, format!("write record {num} = {min}"), w),
                         step(Role::Check, format!("read record {num}"), read.clone()),
                     ],
                     tol: EXCHANGE,
@@ -705,7 +672,7 @@ impl Gen<'_> {
                         step(
                             Role::Check,
                             format!("write record {num} = {max}, control {ignore}"),
-                            Action::Record(w),
+                            w,
                         ),
                         step(
                             Role::Check,
@@ -717,7 +684,7 @@ impl Gen<'_> {
                     plot: false,
                 },
             );
-            if let RecordRequest::Write { data, .. } = self.record_write(index, execute, min)? {
+            if let Step::RecordWrite { hex: data, .. } = self.record_write(index, execute, min)? {
                 let short = data
                     .get(..data.len().saturating_sub(1))
                     .unwrap_or(&[])
@@ -731,7 +698,7 @@ impl Gen<'_> {
                             step(
                                 Role::Check,
                                 format!("write record {num}, {} bytes", short.len()),
-                                Action::Record(RecordRequest::Write { index, data: short }),
+                                Step::RecordWrite { index, hex: short },
                             ),
                             step(Role::Check, format!("read record {num}: unchanged"), read),
                         ],
@@ -750,7 +717,7 @@ impl Gen<'_> {
                     steps: vec![step(
                         Role::Check,
                         format!("read record {index}"),
-                        Action::Record(RecordRequest::Read { index }),
+                        Step::RecordRead { index },
                     )],
                     tol: EXCHANGE,
                     plot: false,
@@ -778,9 +745,13 @@ impl Gen<'_> {
         steps.push(step(
             Role::Setup,
             format!("write par {pnu} = {value}"),
-            Action::Pkw(req),
+            Step::Pkw { pkw: req.into() },
         ));
-        steps.push(step(Role::Setup, "no command", Action::Pkw(none)));
+        steps.push(step(
+            Role::Setup,
+            "no command",
+            Step::Pkw { pkw: none.into() },
+        ));
     }
 
     fn sequence_cases(&mut self) {
@@ -857,7 +828,9 @@ impl Gen<'_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: {}", kebab(&e)),
-                        Action::Env(env),
+                        Step::Env {
+                            env: env.to_string(),
+                        },
                     ));
                 }
                 let (control, target) = (s.control, s.target);
@@ -865,7 +838,7 @@ impl Gen<'_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: target = actual {o:+}"),
-                        Action::Offset { control, offset: o },
+                        Step::Offset { control, offset: o },
                     ));
                 } else {
                     let text = match (control, target) {
@@ -874,18 +847,18 @@ impl Gen<'_> {
                         (None, Some(t)) => format!("step {n}: target {t}"),
                         (None, None) => format!("step {n}: one cycle"),
                     };
-                    steps.push(step(Role::Check, text, Action::Process { control, target }));
+                    steps.push(step(Role::Check, text, Step::Process { control, target }));
                 }
                 let wait = match s.wait {
-                    Wait::Running => Action::Until {
+                    Wait::Running => Step::Until {
                         running: true,
                         max: 1_000,
                     },
-                    Wait::Standstill => Action::Until {
+                    Wait::Standstill => Step::Until {
                         running: false,
                         max: 12_000,
                     },
-                    Wait::Settle => Action::Hold(50),
+                    Wait::Settle => Step::Hold { cycles: 50 },
                 };
                 steps.push(step(
                     Role::Check,
@@ -896,11 +869,13 @@ impl Gen<'_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: obstruction removed"),
-                        Action::Env(Env::Jam(false)),
+                        Step::Env {
+                            env: Env::Jam(false).to_string(),
+                        },
                     ));
                 }
             }
-            steps.push(step(Role::Check, "settle", Action::Hold(10)));
+            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 10 }));
             let reqs: Vec<&str> = v.requirements.iter().map(String::as_str).collect();
             self.push(
                 format!("psd4xx/sequence/{}", v.id),
@@ -917,7 +892,7 @@ impl Gen<'_> {
 
     fn motion(&mut self, id: &str, reqs: &[&str], description: &str, steps: Vec<StepDef>) {
         let mut steps = steps;
-        steps.push(step(Role::Check, "settle", Action::Hold(10)));
+        steps.push(step(Role::Check, "settle", Step::Hold { cycles: 10 }));
         self.push(
             id.to_owned(),
             reqs,
@@ -943,7 +918,7 @@ impl Gen<'_> {
             step(
                 Role::Check,
                 format!("control {c:#06x}, target {t}"),
-                Action::Process {
+                Step::Process {
                     control: Some(c),
                     target: Some(t),
                 },
@@ -953,7 +928,7 @@ impl Gen<'_> {
             step(
                 Role::Check,
                 format!("control {c:#06x}"),
-                Action::Process {
+                Step::Process {
                     control: Some(c),
                     target: None,
                 },
@@ -963,7 +938,7 @@ impl Gen<'_> {
             step(
                 Role::Check,
                 "until running",
-                Action::Until {
+                Step::Until {
                     running: true,
                     max: 1_000,
                 },
@@ -973,13 +948,13 @@ impl Gen<'_> {
             step(
                 Role::Check,
                 "until standstill",
-                Action::Until {
+                Step::Until {
                     running: false,
                     max: 12_000,
                 },
             )
         };
-        let hold = |n: u32| step(Role::Check, format!("{n} cycles"), Action::Hold(n));
+        let hold = |n: u32| step(Role::Check, format!("{n} cycles"), Step::Hold { cycles: n });
         self.motion(
             "psd4xx/position/loop/up",
             &[
@@ -1057,7 +1032,13 @@ impl Gen<'_> {
             &["PSD-STS-8-SET-1"],
             "status word after switching on",
             vec![
-                step(Role::Check, "power cycle", Action::Env(Env::PowerCycle)),
+                step(
+                    Role::Check,
+                    "power cycle",
+                    Step::Env {
+                        env: Env::PowerCycle.to_string(),
+                    },
+                ),
                 hold(10),
             ],
         );
@@ -1086,13 +1067,21 @@ impl Gen<'_> {
             vec![
                 run(rt, 40_000),
                 running(),
-                step(Role::Check, "obstruction", Action::Env(Env::Jam(true))),
+                step(
+                    Role::Check,
+                    "obstruction",
+                    Step::Env {
+                        env: Env::Jam(true).to_string(),
+                    },
+                ),
                 still(),
                 hold(20),
                 step(
                     Role::Check,
                     "obstruction removed",
-                    Action::Env(Env::Jam(false)),
+                    Step::Env {
+                        env: Env::Jam(false).to_string(),
+                    },
                 ),
                 hold(10),
             ],
@@ -1154,7 +1143,7 @@ impl Gen<'_> {
             steps.push(step(
                 Role::Check,
                 "until standstill",
-                Action::Until {
+                Step::Until {
                     running: false,
                     max: 12_000,
                 },
@@ -1163,9 +1152,11 @@ impl Gen<'_> {
             steps.push(step(
                 Role::Check,
                 "power cycle",
-                Action::Env(Env::PowerCycle),
+                Step::Env {
+                    env: Env::PowerCycle.to_string(),
+                },
             ));
-            steps.push(step(Role::Check, "settle", Action::Hold(5)));
+            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 5 }));
             self.exchange(
                 &mut steps,
                 Role::Check,
@@ -1209,6 +1200,16 @@ pub(crate) fn generate(
     g.sequence_cases();
     g.position_cases()?;
     g.par96_cases()?;
+    for (info, case) in &g.out {
+        for s in &case.steps {
+            if let Step::Env { env } = &s.action {
+                if super::session::env_request(0, env).is_none() {
+                    g.errors
+                        .push(format!("{}: env {env:?} is not an injection", info.id));
+                }
+            }
+        }
+    }
     if let Some(first) = g.errors.first() {
         return Err(format!(
             "{} problem(s) generating PSD4xx cases, first: {first}; all: {}",
