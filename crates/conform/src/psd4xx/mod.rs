@@ -19,6 +19,7 @@
 
 pub(crate) mod cases;
 pub(crate) mod fuzz;
+mod scenario;
 mod session;
 
 pub(crate) use session::{Psd4xx, Psd4xxSession};
