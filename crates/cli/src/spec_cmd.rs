@@ -134,6 +134,7 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
                 .into_iter()
                 .chain(drivespec_psx3xx::step::check_steps(spec))
                 .chain(drivespec_psx3xx::scenario::check_scenarios(spec))
+                .chain(drivespec_conform::psd4xx::check_scenarios(spec))
                 .collect();
             // Suites and simulators are built from a spec whose steps read.
             let built = if steps.is_empty() {

@@ -95,6 +95,37 @@ fn broken_spec_folder_fails_check_with_one_line_per_problem() {
     assert_eq!(code, 2);
 }
 
+/// A misspelt key in a step of a PSD4xx scenario fails `spec check` naming file, scenario,
+/// step and key.
+#[test]
+fn misspelt_scenario_key_fails_check_naming_file_scenario_step_and_key() {
+    let dir = std::env::temp_dir().join(format!("drivespec-scenario-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec");
+    copy_dir(std::path::Path::new(src), &dir);
+    let path = dir.join("psd4xx/scenarios/pkw.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let from = "{ do = \"hold\", cycles = 3, text = \"hold\" }";
+    assert_eq!(text.matches(from).count(), 1);
+    std::fs::write(
+        &path,
+        text.replace(from, "{ do = \"hold\", cylces = 3, text = \"hold\" }"),
+    )
+    .unwrap();
+    let (code, stdout, stderr) = run(BIN, &["spec", "check", "--spec", dir.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 1, "{stdout}");
+    assert!(
+        lines[0].starts_with(
+            "psd4xx/scenarios/pkw.toml: scenario \"pkw/no-command\": steps[2]: unknown field `cylces`"
+        ),
+        "{}",
+        lines[0]
+    );
+}
+
 /// A misspelt key in a step of a `sequence` vector fails `spec check` naming file, record,
 /// step and key, in each cyclic family.
 #[test]

@@ -2,58 +2,22 @@
 //! per model), PKW command and error tables, control-word values and `sequence` vectors, plus
 //! hand-written positioning and status cases.
 
+use super::scenario::{self, Judge, ScenarioStep, Setup, SpecStep, Target, TargetName};
 use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
 use drivespec_positioner::script::kebab;
 use drivespec_positioner::step::{read_sequence, StateValue, Wait};
-use drivespec_psd4xx::model::{Drive, LinkEvent, RecordRequest};
-use drivespec_psd4xx::step::{Direction, Event, PsdSequence};
+use drivespec_psd4xx::model::{Drive, LinkEvent};
+use drivespec_psd4xx::step::{Direction, Event, PsdSequence, Step};
 use drivespec_psd4xx::{PkwRequest, PkwRules, RecordWrite, Request, Rules, Width};
 use drivespec_spec::{Access, DeviceModel, Family, FamilyId, Level, Parameter, VectorKind};
-
-/// One action of a case; both the device and the reference get exactly the same inputs.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Action {
-    /// New process data (absent: unchanged), then one cycle.
-    Process {
-        /// Control word.
-        control: Option<u16>,
-        /// Target value.
-        target: Option<i32>,
-    },
-    /// A PKW block; cycles until the reference and the device answer it.
-    Pkw(PkwRequest),
-    /// New control word (absent: unchanged) and a target relative to the reference's actual
-    /// position, then one cycle.
-    Offset {
-        /// Control word.
-        control: Option<u16>,
-        /// Target minus actual position.
-        offset: i64,
-    },
-    /// Cycles with the outputs unchanged.
-    Hold(u32),
-    /// Cycles until the reference is running (`true`) or at standstill (`false`).
-    Until {
-        /// Wait for status bit "drive is running" set (true) or clear (false).
-        running: bool,
-        /// Most cycles.
-        max: u32,
-    },
-    /// An acyclic record.
-    Record(RecordRequest),
-    /// An environment injection.
-    Env(Env),
-    /// Time passes by this many µs without a bus cycle (`ADVANCE`).
-    Advance(u64),
-}
 
 /// Cycles a PKW command is repeated beyond the longest save before the case moves on
 /// (PSD-PKW-002).
 pub(crate) const PKW_MAX_CYCLES: u32 = 8;
 
 /// One step of a case.
-pub(crate) type StepDef = crate::cyclic_session::StepDef<Action>;
+pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
 
 pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
 
@@ -103,7 +67,7 @@ pub(crate) fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
         .ok_or_else(|| format!("no control bit {name:?}"))
 }
 
-fn step(role: Role, text: impl Into<String>, action: Action) -> StepDef {
+fn step(role: Role, text: impl Into<String>, action: Step) -> StepDef {
     StepDef {
         role,
         text: text.into(),
@@ -158,14 +122,18 @@ impl Gen<'_> {
     fn exchange(&mut self, steps: &mut Vec<StepDef>, role: Role, text: &str, r: Request) {
         let req = self.request(r);
         let none = self.none();
-        steps.push(step(role, text, Action::Pkw(req)));
+        steps.push(step(role, text, Step::Pkw { pkw: req.into() }));
         steps.push(step(
             role,
             "command repeated: the response is held",
-            Action::Hold(3),
+            Step::Hold { cycles: 3 },
         ));
-        steps.push(step(role, "no command: no response", Action::Pkw(none)));
-        steps.push(step(role, "no response held", Action::Hold(2)));
+        steps.push(step(
+            role,
+            "no command: no response",
+            Step::Pkw { pkw: none.into() },
+        ));
+        steps.push(step(role, "no response held", Step::Hold { cycles: 2 }));
     }
 
     fn range(&self, p: &Parameter) -> Option<(i64, i64)> {
@@ -430,88 +398,8 @@ impl Gen<'_> {
         }
     }
 
-    fn pkw_rules_cases(&mut self) -> Result<(), String> {
+    fn pkw_rules_cases(&mut self) {
         let none = self.none();
-        // No command only.
-        self.push(
-            "psd4xx/pkw/no-command".to_owned(),
-            &["PSD-PKW-006", "PSD-PKW-010"],
-            "command 0 is answered with response 0".to_owned(),
-            PsdCase {
-                steps: vec![
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                    step(Role::Check, "hold", Action::Hold(3)),
-                ],
-                tol: EXCHANGE,
-                plot: false,
-            },
-        );
-        // The response holds the value of the moment of the command (par 3 while running).
-        let rt = control(self.family, "release-and-transfer")?;
-        let read3 = self.request(Request::Read {
-            pnu: 3,
-            index: None,
-        });
-        self.push(
-            "psd4xx/pkw/held-while-running".to_owned(),
-            &["PSD-PKW-003", "PSD-PKW-004", "PSD-PKW-007"],
-            "a read of the actual position during a run keeps its value while the command is repeated".to_owned(),
-            PsdCase {
-                steps: vec![
-                    step(Role::Setup, "0x14 to 400000", Action::Process { control: Some(rt), target: Some(400_000) }),
-                    step(Role::Setup, "until running", Action::Until { running: true, max: 200 }),
-                    step(Role::Setup, "run a while", Action::Hold(20)),
-                    step(Role::Check, "read par 3", Action::Pkw(read3)),
-                    step(Role::Check, "repeat: value held", Action::Hold(20)),
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                    step(Role::Check, "read par 3 again: a new value", Action::Pkw(read3)),
-                    step(Role::Check, "repeat", Action::Hold(5)),
-                ],
-                tol: EXCHANGE,
-                plot: false,
-            },
-        );
-        // Re-reading needs command 0 in between (a record changes the value meanwhile).
-        let read44 = self.request(Request::Read {
-            pnu: 44,
-            index: None,
-        });
-        let w44 = self.record_write(44, 1, 7)?;
-        self.push(
-            "psd4xx/pkw/reread-after-no-command".to_owned(),
-            &["PSD-PKW-005", "PSD-PKW-003"],
-            "repeating a read without command 0 keeps the old answer; after command 0 the new value comes".to_owned(),
-            PsdCase {
-                steps: vec![
-                    step(Role::Check, "read par 44", Action::Pkw(read44)),
-                    step(Role::Setup, "record write par 44 = 7", Action::Record(w44)),
-                    step(Role::Check, "repeat the read: old answer held", Action::Hold(4)),
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                    step(Role::Check, "read par 44: 7", Action::Pkw(read44)),
-                ],
-                tol: EXCHANGE,
-                plot: false,
-            },
-        );
-        // Array command on a scalar.
-        let arr = self.request(Request::Read {
-            pnu: 44,
-            index: Some(0),
-        });
-        self.push(
-            "psd4xx/pkw/error/no-array".to_owned(),
-            &["PSD-PKW-027", "PSD-PKW-019"],
-            "an array read of the scalar par 44: error 4".to_owned(),
-            PsdCase {
-                steps: vec![
-                    step(Role::Check, "array read of par 44", Action::Pkw(arr)),
-                    step(Role::Check, "hold", Action::Hold(2)),
-                    step(Role::Check, "no command", Action::Pkw(none)),
-                ],
-                tol: EXCHANGE,
-                plot: false,
-            },
-        );
         // An undefined command code.
         let undefined = (0..=self.pkw.ak_max())
             .map(drivespec_psd4xx::CommandCode::from)
@@ -530,65 +418,22 @@ impl Gen<'_> {
                 format!("command code {} (not in the table): error 18", u8::from(ak)),
                 PsdCase {
                     steps: vec![
-                        step(Role::Check, "undefined command on par 44", Action::Pkw(req)),
-                        step(Role::Check, "hold", Action::Hold(2)),
-                        step(Role::Check, "no command", Action::Pkw(none)),
+                        step(
+                            Role::Check,
+                            "undefined command on par 44",
+                            Step::Pkw { pkw: req.into() },
+                        ),
+                        step(Role::Check, "hold", Step::Hold { cycles: 2 }),
+                        step(Role::Check, "no command", Step::Pkw { pkw: none.into() }),
                     ],
                     tol: EXCHANGE,
                     plot: false,
                 },
             );
         }
-        // A standstill-only write while running (par 45, the loop length).
-        if let Some(p45) = self.family.parameter("45") {
-            if let Some(w) = Self::width(p45) {
-                let value = self
-                    .family
-                    .resolve(p45, Some(self.model))
-                    .default
-                    .unwrap_or(0);
-                let req = self.request(Request::Write {
-                    pnu: 45,
-                    index: None,
-                    width: w,
-                    value,
-                });
-                self.push(
-                    "psd4xx/pkw/error/operating-state".to_owned(),
-                    &["PSD-PKW-030", "PSD-PKW-019"],
-                    "writing par 45 during a run: error 17".to_owned(),
-                    PsdCase {
-                        steps: vec![
-                            step(
-                                Role::Setup,
-                                "0x14 to 400000",
-                                Action::Process {
-                                    control: Some(rt),
-                                    target: Some(400_000),
-                                },
-                            ),
-                            step(
-                                Role::Setup,
-                                "until running",
-                                Action::Until {
-                                    running: true,
-                                    max: 200,
-                                },
-                            ),
-                            step(Role::Check, "write par 45", Action::Pkw(req)),
-                            step(Role::Check, "hold", Action::Hold(2)),
-                            step(Role::Check, "no command", Action::Pkw(none)),
-                        ],
-                        tol: EXCHANGE,
-                        plot: false,
-                    },
-                );
-            }
-        }
-        Ok(())
     }
 
-    fn record_write(&self, index: u16, control: u8, value: i64) -> Result<RecordRequest, String> {
+    fn record_write(&self, index: u16, control: u8, value: i64) -> Result<Step, String> {
         let p = self
             .family
             .parameters
@@ -605,7 +450,7 @@ impl Gen<'_> {
         }
         .to_bytes(rules)
         .map_err(|e| format!("record write {index}: {e}"))?;
-        Ok(RecordRequest::Write { index, data })
+        Ok(Step::RecordWrite { index, hex: data })
     }
 }
 
@@ -642,7 +487,7 @@ impl Gen<'_> {
                     steps: vec![step(
                         Role::Check,
                         format!("read record {num}"),
-                        Action::Record(RecordRequest::Read { index }),
+                        Step::RecordRead { index },
                     )],
                     tol: EXCHANGE,
                     plot: false,
@@ -659,11 +504,7 @@ impl Gen<'_> {
                     &["PSD-REC-001", "PSD-PAR-READONLY-001"],
                     format!("record write to the read-only par {num}: refused"),
                     PsdCase {
-                        steps: vec![step(
-                            Role::Check,
-                            format!("write record {num}"),
-                            Action::Record(w),
-                        )],
+                        steps: vec![step(Role::Check, format!("write record {num}"), w)],
                         tol: EXCHANGE,
                         plot: false,
                     },
@@ -678,7 +519,7 @@ impl Gen<'_> {
             } else {
                 "PSD-REC-007"
             };
-            let read = Action::Record(RecordRequest::Read { index });
+            let read = Step::RecordRead { index };
             let w = self.record_write(index, execute, min)?;
             self.push(
                 format!("psd4xx/record/write/{num}/execute"),
@@ -686,11 +527,7 @@ impl Gen<'_> {
                 format!("record write par {num} = {min} with control byte {execute}, read back"),
                 PsdCase {
                     steps: vec![
-                        step(
-                            Role::Check,
-                            format!("write record {num} = {min}"),
-                            Action::Record(w),
-                        ),
+                        step(Role::Check, format!("write record {num} = {min}"), w),
                         step(Role::Check, format!("read record {num}"), read.clone()),
                     ],
                     tol: EXCHANGE,
@@ -707,7 +544,7 @@ impl Gen<'_> {
                         step(
                             Role::Check,
                             format!("write record {num} = {max}, control {ignore}"),
-                            Action::Record(w),
+                            w,
                         ),
                         step(
                             Role::Check,
@@ -719,7 +556,7 @@ impl Gen<'_> {
                     plot: false,
                 },
             );
-            if let RecordRequest::Write { data, .. } = self.record_write(index, execute, min)? {
+            if let Step::RecordWrite { hex: data, .. } = self.record_write(index, execute, min)? {
                 let short = data
                     .get(..data.len().saturating_sub(1))
                     .unwrap_or(&[])
@@ -733,7 +570,7 @@ impl Gen<'_> {
                             step(
                                 Role::Check,
                                 format!("write record {num}, {} bytes", short.len()),
-                                Action::Record(RecordRequest::Write { index, data: short }),
+                                Step::RecordWrite { index, hex: short },
                             ),
                             step(Role::Check, format!("read record {num}: unchanged"), read),
                         ],
@@ -752,7 +589,7 @@ impl Gen<'_> {
                     steps: vec![step(
                         Role::Check,
                         format!("read record {index}"),
-                        Action::Record(RecordRequest::Read { index }),
+                        Step::RecordRead { index },
                     )],
                     tol: EXCHANGE,
                     plot: false,
@@ -780,9 +617,13 @@ impl Gen<'_> {
         steps.push(step(
             Role::Setup,
             format!("write par {pnu} = {value}"),
-            Action::Pkw(req),
+            Step::Pkw { pkw: req.into() },
         ));
-        steps.push(step(Role::Setup, "no command", Action::Pkw(none)));
+        steps.push(step(
+            Role::Setup,
+            "no command",
+            Step::Pkw { pkw: none.into() },
+        ));
     }
 
     fn sequence_cases(&mut self) {
@@ -859,7 +700,9 @@ impl Gen<'_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: {}", kebab(&e)),
-                        Action::Env(env),
+                        Step::Env {
+                            env: env.to_string(),
+                        },
                     ));
                 }
                 let (control, target) = (s.control, s.target);
@@ -867,7 +710,7 @@ impl Gen<'_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: target = actual {o:+}"),
-                        Action::Offset { control, offset: o },
+                        Step::Offset { control, offset: o },
                     ));
                 } else {
                     let text = match (control, target) {
@@ -876,18 +719,18 @@ impl Gen<'_> {
                         (None, Some(t)) => format!("step {n}: target {t}"),
                         (None, None) => format!("step {n}: one cycle"),
                     };
-                    steps.push(step(Role::Check, text, Action::Process { control, target }));
+                    steps.push(step(Role::Check, text, Step::Process { control, target }));
                 }
                 let wait = match s.wait {
-                    Wait::Running => Action::Until {
+                    Wait::Running => Step::Until {
                         running: true,
                         max: 1_000,
                     },
-                    Wait::Standstill => Action::Until {
+                    Wait::Standstill => Step::Until {
                         running: false,
                         max: 12_000,
                     },
-                    Wait::Settle => Action::Hold(50),
+                    Wait::Settle => Step::Hold { cycles: 50 },
                 };
                 steps.push(step(
                     Role::Check,
@@ -898,11 +741,13 @@ impl Gen<'_> {
                     steps.push(step(
                         Role::Check,
                         format!("step {n}: obstruction removed"),
-                        Action::Env(Env::Jam(false)),
+                        Step::Env {
+                            env: Env::Jam(false).to_string(),
+                        },
                     ));
                 }
             }
-            steps.push(step(Role::Check, "settle", Action::Hold(10)));
+            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 10 }));
             let reqs: Vec<&str> = v.requirements.iter().map(String::as_str).collect();
             self.push(
                 format!("psd4xx/sequence/{}", v.id),
@@ -917,195 +762,133 @@ impl Gen<'_> {
         }
     }
 
-    fn motion(&mut self, id: &str, reqs: &[&str], description: &str, steps: Vec<StepDef>) {
-        let mut steps = steps;
-        steps.push(step(Role::Check, "settle", Action::Hold(10)));
-        self.push(
-            id.to_owned(),
-            reqs,
-            description.to_owned(),
-            PsdCase {
-                steps,
-                tol: MOTION,
-                plot: true,
-            },
-        );
+    /// The cases of the scenario files, each step resolved against the spec.
+    fn scenario_cases(&mut self) {
+        let f = self.family;
+        for sc in &f.scenarios {
+            let typed = match sc.typed::<Setup, ScenarioStep>() {
+                Ok(t) => t,
+                Err(e) => {
+                    self.errors
+                        .push(format!("{}: scenario {:?}: {e}", sc.file, sc.id));
+                    continue;
+                }
+            };
+            let mut steps = Vec::new();
+            for (n, s) in typed.steps.iter().enumerate() {
+                match self.resolve(s) {
+                    Ok(d) => steps.push(d),
+                    Err(e) => self.errors.push(format!(
+                        "{}: scenario {:?}: steps[{}]: {e}",
+                        sc.file,
+                        sc.id,
+                        n.saturating_add(1)
+                    )),
+                }
+            }
+            let reqs: Vec<&str> = sc.requirements.iter().map(String::as_str).collect();
+            let tol = match typed.setup.judge {
+                Judge::Exact => EXCHANGE,
+                Judge::Motion => MOTION,
+            };
+            self.push(
+                format!("psd4xx/{}", sc.id),
+                &reqs,
+                sc.description.clone(),
+                PsdCase {
+                    steps,
+                    tol,
+                    plot: typed.setup.plot,
+                },
+            );
+        }
     }
 
-    fn position_cases(&mut self) -> Result<(), String> {
-        let f = self.family;
-        let rt = control(f, "release-and-transfer")?;
-        let direct = control(f, "release-and-transfer-without-loop")?;
-        let up = control(f, "manual-run-larger")?;
-        let down = control(f, "manual-run-smaller")?;
-        let release = control(f, "release")?;
-        let stop = control(f, "stop")?;
-        let toggle = control_bit(f, "Toggle bit")?;
-        let run = |c: u16, t: i32| {
-            step(
-                Role::Check,
-                format!("control {c:#06x}, target {t}"),
-                Action::Process {
-                    control: Some(c),
-                    target: Some(t),
-                },
-            )
+    /// A scenario step as the suite runs it.
+    fn resolve(&mut self, s: &ScenarioStep) -> Result<StepDef, String> {
+        let action = match &s.action {
+            scenario::Action::Step(step) => step.clone(),
+            scenario::Action::Spec(spec) => self.spec_step(spec)?,
         };
-        let ctl = |c: u16| {
-            step(
-                Role::Check,
-                format!("control {c:#06x}"),
-                Action::Process {
-                    control: Some(c),
-                    target: None,
-                },
-            )
+        let text = match (&s.text, &action) {
+            (Some(t), _) => t.clone(),
+            (None, Step::Process { control, target }) => match (control, target) {
+                (Some(c), Some(t)) => format!("control {c:#06x}, target {t}"),
+                (Some(c), None) => format!("control {c:#06x}"),
+                (None, Some(t)) => format!("target {t}"),
+                (None, None) => "one cycle".to_owned(),
+            },
+            (None, Step::Until { running: true, .. }) => "until running".to_owned(),
+            (None, Step::Until { running: false, .. }) => "until standstill".to_owned(),
+            (None, Step::Hold { cycles }) => format!("{cycles} cycles"),
+            (None, other) => return Err(format!("a `{}` step needs `text`", other.name())),
         };
-        let running = || {
-            step(
-                Role::Check,
-                "until running",
-                Action::Until {
-                    running: true,
-                    max: 1_000,
-                },
-            )
-        };
-        let still = || {
-            step(
-                Role::Check,
-                "until standstill",
-                Action::Until {
-                    running: false,
-                    max: 12_000,
-                },
-            )
-        };
-        let hold = |n: u32| step(Role::Check, format!("{n} cycles"), Action::Hold(n));
-        self.motion(
-            "psd4xx/position/loop/up",
-            &[
-                "PSD-POS-001",
-                "PSD-POS-007",
-                "PSD-POS-010",
-                "PSD-STS-0-SET-1",
-            ],
-            "0x14 to a larger target: direct approach in loop direction",
-            vec![run(rt, 4000), running(), still()],
-        );
-        self.motion(
-            "psd4xx/position/loop/down",
-            &["PSD-POS-001", "PSD-POS-007", "PSD-POS-011", "PSD-POS-012"],
-            "0x14 to a smaller target: overrun by the loop, approach in loop direction",
-            vec![run(rt, -4000), running(), still()],
-        );
-        self.motion(
-            "psd4xx/position/no-loop/up",
-            &["PSD-POS-017"],
-            "0x54 to a larger target: direct",
-            vec![run(direct, 4000), running(), still()],
-        );
-        self.motion(
-            "psd4xx/position/no-loop/down",
-            &["PSD-POS-017", "PSD-POS-012"],
-            "0x54 to a smaller target: direct, no loop",
-            vec![run(direct, -4000), running(), still()],
-        );
-        self.motion(
-            "psd4xx/position/manual/up",
-            &["PSD-RUN-004", "PSD-RUN-005", "PSD-STS-0-SET-2"],
-            "0x11 manual run up, then 0x10 stops",
-            vec![ctl(up), running(), hold(50), ctl(release), still()],
-        );
-        self.motion(
-            "psd4xx/position/manual/down",
-            &["PSD-RUN-004", "PSD-RUN-006"],
-            "0x12 manual run down, then 0x00 stops",
-            vec![ctl(down), running(), hold(50), ctl(stop), still()],
-        );
-        self.motion(
-            "psd4xx/position/release-withdrawn",
-            &["PSD-RUN-001", "PSD-CTL-4-003", "PSD-STS-5-SET-1"],
-            "0x00 during a run aborts it and sets bit 5",
-            vec![run(rt, 400_000), running(), hold(20), ctl(stop), still()],
-        );
-        self.motion(
-            "psd4xx/position/new-target/same-direction",
-            &["PSD-POS-002", "PSD-POS-003"],
-            "a new target during a run is approached without a stop",
-            vec![
-                run(rt, 40_000),
-                running(),
-                hold(10),
-                run(rt, 80_000),
-                still(),
-            ],
-        );
-        self.motion(
-            "psd4xx/position/new-target/reverse",
-            &["PSD-POS-002"],
-            "a new target behind the drive during a run",
-            vec![
-                run(rt, 400_000),
-                running(),
-                hold(30),
-                run(rt, -4000),
-                still(),
-            ],
-        );
-        // Status.
-        self.motion(
-            "psd4xx/status/power-on",
-            &["PSD-STS-8-SET-1"],
-            "status word after switching on",
-            vec![
-                step(Role::Check, "power cycle", Action::Env(Env::PowerCycle)),
-                hold(10),
-            ],
-        );
-        self.motion(
-            "psd4xx/status/toggle",
-            &["PSD-CTL-13-001"],
-            "control bit 13 is copied into the status word every cycle",
-            vec![
-                ctl(toggle),
-                hold(2),
-                ctl(0),
-                hold(2),
-                ctl(toggle),
-                ctl(0),
-                ctl(toggle | rt),
-                running(),
-                ctl(rt),
-                hold(3),
-                ctl(toggle | rt),
-            ],
-        );
-        self.motion(
-            "psd4xx/status/obstruction",
-            &["PSD-STS-10-SET-1", "PSD-OBST-001"],
-            "an obstruction during a run stops it with bit 10",
-            vec![
-                run(rt, 40_000),
-                running(),
-                step(Role::Check, "obstruction", Action::Env(Env::Jam(true))),
-                still(),
-                hold(20),
-                step(
-                    Role::Check,
-                    "obstruction removed",
-                    Action::Env(Env::Jam(false)),
-                ),
-                hold(10),
-            ],
-        );
-        self.motion(
-            "psd4xx/status/incorrect-target",
-            &["PSD-STS-12-SET-1"],
-            "a target beyond the end limits sets bit 12 and does not run",
-            vec![run(rt, i32::MAX), hold(20)],
-        );
-        Ok(())
+        Ok(step(s.role.into(), text, action))
+    }
+
+    fn pnu(&self, par: &str) -> Result<u16, String> {
+        self.family
+            .parameter(par)
+            .and_then(|p| u16::try_from(p.number).ok())
+            .ok_or_else(|| format!("no par {par:?}"))
+    }
+
+    fn spec_step(&mut self, spec: &SpecStep) -> Result<Step, String> {
+        Ok(match spec {
+            SpecStep::Control { control: c, target } => {
+                let mut value = 0u16;
+                for part in c.split('|').map(str::trim) {
+                    value |= match part.parse::<u16>() {
+                        Ok(n) => n,
+                        Err(_) => control(self.family, part)
+                            .or_else(|_| control_bit(self.family, part))?,
+                    };
+                }
+                Step::Process {
+                    control: Some(value),
+                    target: target.map(|t| match t {
+                        Target::Value(v) => v,
+                        Target::Named(TargetName::TypeMax) => i32::MAX,
+                    }),
+                }
+            }
+            SpecStep::PkwRead { par, index } => {
+                let pnu = self.pnu(par)?;
+                Step::Pkw {
+                    pkw: self.request(Request::Read { pnu, index: *index }).into(),
+                }
+            }
+            SpecStep::PkwNone {} => Step::Pkw {
+                pkw: self.none().into(),
+            },
+            SpecStep::PkwWriteDefault { par } => {
+                let p = self
+                    .family
+                    .parameter(par)
+                    .ok_or_else(|| format!("no par {par:?}"))?;
+                let width = Self::width(p).ok_or_else(|| format!("par {par} has no width"))?;
+                let value = self
+                    .family
+                    .resolve(p, Some(self.model))
+                    .default
+                    .unwrap_or(0);
+                let pnu = self.pnu(par)?;
+                Step::Pkw {
+                    pkw: self
+                        .request(Request::Write {
+                            pnu,
+                            index: None,
+                            width,
+                            value,
+                        })
+                        .into(),
+                }
+            }
+            SpecStep::RecordSet { par, value } => {
+                let execute = self.drive_rules.record().control_ignore().wrapping_add(1);
+                self.record_write(self.pnu(par)?, execute, *value)?
+            }
+        })
     }
 
     fn par96_cases(&mut self) -> Result<(), String> {
@@ -1156,7 +939,7 @@ impl Gen<'_> {
             steps.push(step(
                 Role::Check,
                 "until standstill",
-                Action::Until {
+                Step::Until {
                     running: false,
                     max: 12_000,
                 },
@@ -1165,9 +948,11 @@ impl Gen<'_> {
             steps.push(step(
                 Role::Check,
                 "power cycle",
-                Action::Env(Env::PowerCycle),
+                Step::Env {
+                    env: Env::PowerCycle.to_string(),
+                },
             ));
-            steps.push(step(Role::Check, "settle", Action::Hold(5)));
+            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 5 }));
             self.exchange(
                 &mut steps,
                 Role::Check,
@@ -1206,11 +991,21 @@ pub(crate) fn generate(
         out: Vec::new(),
     };
     g.pkw_cases();
-    g.pkw_rules_cases()?;
+    g.pkw_rules_cases();
     g.record_cases()?;
     g.sequence_cases();
-    g.position_cases()?;
+    g.scenario_cases();
     g.par96_cases()?;
+    for (info, case) in &g.out {
+        for s in &case.steps {
+            if let Step::Env { env } = &s.action {
+                if super::session::env_request(0, env).is_none() {
+                    g.errors
+                        .push(format!("{}: env {env:?} is not an injection", info.id));
+                }
+            }
+        }
+    }
     if let Some(first) = g.errors.first() {
         return Err(format!(
             "{} problem(s) generating PSD4xx cases, first: {first}; all: {}",

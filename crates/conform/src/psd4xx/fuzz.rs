@@ -19,12 +19,12 @@ use crate::case::{CaseInfo, CaseRun, Role};
 use crate::cyclic::Peer;
 use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
 use crate::fuzz::replay::{Action, CyclicStep, Step};
-use crate::psd4xx::cases::{self as cases, PsdCase, StepDef, EXCHANGE, MOTION};
+use crate::psd4xx::cases::{PsdCase, StepDef, EXCHANGE, MOTION};
 use crate::psd4xx::{Psd4xx, Psd4xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
-use drivespec_psd4xx::model::RecordRequest;
-use drivespec_psd4xx::{Input, PkwRequest};
+use drivespec_psd4xx::step::{PkwBlock, Step as PsdStep};
+use drivespec_psd4xx::Input;
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Family, FamilyId, Level};
 use sequences::{PsdGen, ENV_KINDS};
@@ -172,11 +172,11 @@ fn own_kind(c: &CyclicStep) -> Option<String> {
 fn to_case_step(s: &Step) -> StepDef {
     let action = match &s.action {
         Action::Cyclic(c) => match c {
-            CyclicStep::Process { control, target } => cases::Action::Process {
+            CyclicStep::Process { control, target } => PsdStep::Process {
                 control: *control,
                 target: *target,
             },
-            CyclicStep::Offset { control, offset } => cases::Action::Offset {
+            CyclicStep::Offset { control, offset } => PsdStep::Offset {
                 control: *control,
                 offset: *offset,
             },
@@ -186,38 +186,38 @@ fn to_case_step(s: &Step) -> StepDef {
                 pnu,
                 ind,
                 pwe,
-            } => cases::Action::Pkw(PkwRequest {
-                ak: (*ak).into(),
-                spm: *spm,
-                pnu: *pnu,
-                ind: *ind,
-                pwe: *pwe,
-            }),
-            CyclicStep::Hold { cycles } => {
-                cases::Action::Hold((*cycles).min(cyclic_target::MAX_STEP_CYCLES))
-            }
-            CyclicStep::Until { running, max } => cases::Action::Until {
+            } => PsdStep::Pkw {
+                pkw: PkwBlock {
+                    ak: *ak,
+                    spm: *spm,
+                    pnu: *pnu,
+                    ind: *ind,
+                    pwe: *pwe,
+                },
+            },
+            CyclicStep::Hold { cycles } => PsdStep::Hold {
+                cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
+            },
+            CyclicStep::Until { running, max } => PsdStep::Until {
                 running: *running,
                 max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
             },
-            CyclicStep::RecordRead { index } => {
-                cases::Action::Record(RecordRequest::Read { index: *index })
-            }
-            CyclicStep::RecordWrite { index, data } => {
-                cases::Action::Record(RecordRequest::Write {
-                    index: *index,
-                    data: data.clone(),
-                })
-            }
-            CyclicStep::Env(env) => cases::Action::Env(*env),
-            CyclicStep::Advance { us } => {
-                cases::Action::Advance((*us).min(cyclic_target::MAX_ADVANCE_US))
-            }
+            CyclicStep::RecordRead { index } => PsdStep::RecordRead { index: *index },
+            CyclicStep::RecordWrite { index, data } => PsdStep::RecordWrite {
+                index: *index,
+                hex: data.clone(),
+            },
+            CyclicStep::Env(env) => PsdStep::Env {
+                env: env.to_string(),
+            },
+            CyclicStep::Advance { us } => PsdStep::Advance {
+                us: (*us).min(cyclic_target::MAX_ADVANCE_US),
+            },
             CyclicStep::ProcessData { .. }
             | CyclicStep::IsduRead { .. }
-            | CyclicStep::IsduWrite { .. } => cases::Action::Hold(1),
+            | CyclicStep::IsduWrite { .. } => PsdStep::Hold { cycles: 1 },
         },
-        _ => cases::Action::Hold(1),
+        _ => PsdStep::Hold { cycles: 1 },
     };
     StepDef {
         role: Role::Check,

@@ -19,6 +19,7 @@
 
 pub(crate) mod cases;
 pub(crate) mod fuzz;
+mod scenario;
 mod session;
 
 pub(crate) use session::{Psd4xx, Psd4xxSession};
@@ -34,6 +35,14 @@ use drivespec_spec::{Family, FamilyId, Spec};
 
 /// The device model `--model` selects when none is given.
 pub use drivespec_sim::reference::PSD4XX_DEFAULT_MODEL as DEFAULT_MODEL;
+
+/// Every PSD4xx scenario whose setup or steps do not read, naming file, scenario, step and
+/// key (`drivespec spec check`).
+pub fn check_scenarios(spec: &Spec) -> Vec<drivespec_spec::Problem> {
+    drivespec_spec::check_scenarios::<scenario::Setup, scenario::ScenarioStep>(
+        spec.family(FamilyId::Psd4xx),
+    )
+}
 
 /// Bus cycle of the runner (µs): one output image and one input image per cycle.
 pub const CYCLE_US: u64 = 10_000;

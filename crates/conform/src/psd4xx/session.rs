@@ -1,12 +1,12 @@
 //! Running PSD4xx cases ([`crate::cyclic_session`]): every cycle's input image (PKW block and
 //! status word exact) and every record and injection reply is compared with the reference's.
 
-use super::cases::{status_bit, Action, PsdCase, StepDef, PKW_MAX_CYCLES};
+use super::cases::{status_bit, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::CaseInfo;
 use crate::cyclic::{Reply, Request, Server};
 use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
-use drivespec_psd4xx::model::RecordRequest;
+use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::{Input, Output, PkwRequest};
 use drivespec_spec::{Family, FamilyId, Protocol};
 
@@ -49,7 +49,7 @@ impl<'a, 's> Psd4xx<'a, 's> {
 impl CyclicFamily<'static> for Psd4xx<'_, '_> {
     type Input = Input;
     type Output = Output;
-    type Action = Action;
+    type Action = Step;
     type Case = PsdCase;
     const ID: FamilyId = FamilyId::Psd4xx;
     const EXACT: &'static str = "PKW and status";
@@ -225,10 +225,10 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         (expected.to_string() == got.to_string(), None)
     }
 
-    fn op(&self, action: &Action, out: &Output, last: Option<&Input>, t: u64) -> Op<Output> {
+    fn op(&self, action: &Step, out: &Output, last: Option<&Input>, t: u64) -> Op<Output> {
         let mut next = *out;
         match action {
-            Action::Process { control, target } => {
+            Step::Process { control, target } => {
                 if let Some(c) = control {
                     next.control = *c;
                 }
@@ -237,7 +237,7 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
                 }
                 Op::Send { out: next, max: 1 }
             }
-            Action::Offset { control, offset } => {
+            Step::Offset { control, offset } => {
                 if let Some(c) = control {
                     next.control = *c;
                 }
@@ -246,37 +246,37 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
                 next.target = i32::try_from(t).unwrap_or(if t < 0 { i32::MIN } else { i32::MAX });
                 Op::Send { out: next, max: 1 }
             }
-            Action::Pkw(req) => {
-                next.pkw = *req;
+            Step::Pkw { pkw } => {
+                next.pkw = PkwRequest::from(*pkw);
                 Op::Send {
                     out: next,
                     max: self.pkw_cycles(),
                 }
             }
-            Action::Hold(k) => Op::Hold(*k),
-            Action::Until { running, max } => Op::Until {
+            Step::Hold { cycles } => Op::Hold(*cycles),
+            Step::Until { running, max } => Op::Until {
                 running: *running,
                 max: *max,
             },
-            Action::Record(r) => Op::Exchange(match r {
-                RecordRequest::Read { index } => Request::Read { t, index: *index },
-                RecordRequest::Write { index, data } => Request::Write {
-                    t,
-                    index: *index,
-                    data: data.clone(),
-                },
+            Step::RecordRead { index } => Op::Exchange(Request::Read { t, index: *index }),
+            Step::RecordWrite { index, hex } => Op::Exchange(Request::Write {
+                t,
+                index: *index,
+                data: hex.clone(),
             }),
-            Action::Env(env) => Op::Exchange(Request::Env { t, env: *env }),
-            Action::Advance(us) => Op::Advance(*us),
+            // Built steps carry checked text; an unchecked one holds for no cycle.
+            Step::Env { env } => env_request(t, env).map_or(Op::Hold(0), Op::Exchange),
+            Step::Advance { us } => Op::Advance(*us),
         }
     }
 
     /// A PKW block is answered when the reference's response answers it ("no command" and
     /// commands without an operation: when it says "no response").
-    fn answered(&self, action: &Action, i: &Input) -> bool {
-        let Action::Pkw(req) = action else {
+    fn answered(&self, action: &Step, i: &Input) -> bool {
+        let Step::Pkw { pkw: req } = action else {
             return true;
         };
+        let req = &PkwRequest::from(*req);
         let pkw = self.suite.reference().rules().pkw();
         if req == &PkwRequest::default()
             || pkw
@@ -287,5 +287,14 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         } else {
             pkw.answers(req, &i.pkw)
         }
+    }
+}
+
+/// The `ENV` request of an environment step's text at time `t`; None when the text is not an
+/// injection (suite and replay steps are checked with it when they are built).
+pub(crate) fn env_request(t: u64, text: &str) -> Option<Request> {
+    match Request::parse(&format!("ENV {t} {text}")) {
+        Ok(r @ Request::Env { .. }) => Some(r),
+        _ => None,
     }
 }
