@@ -12,10 +12,10 @@
 
 mod support;
 
-use drivespec_conform::case::Outcome;
 use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::psx3xx::Psx3xxSuite;
-use drivespec_conform::suite::{Session, Settings, Suite};
+use drivespec_conform::suite::{Settings, Suite};
+use support::legal::{describe, failures};
 use support::mutants::spec;
 use support::psx3xx_variants::{variants, Kind, Variant};
 
@@ -26,19 +26,12 @@ fn every_psx3xx_legal_variant_passes() {
     for (name, kind) in variants() {
         let server = Server::new(name, "psx3xx", Box::new(Variant::new(kind)));
         let mut session = suite.session(Box::new(LocalPeer::new(name, server)));
-        let mut failed = Vec::new();
-        for (i, info) in suite.cases().iter().enumerate() {
-            if let Outcome::Fail(f) = session.run(i).outcome {
-                failed.push(info.id.clone());
-                if !matches!(kind, Kind::StartLatency(_)) {
-                    problems.push(format!(
-                        "{name}: {} failed: {}\n  expected {}\n  got      {}",
-                        info.id, f.message, f.expected, f.got
-                    ));
-                }
-            }
+        let failed = failures(suite.cases(), &mut session);
+        let ids: Vec<&str> = failed.iter().map(|(id, _)| id.as_str()).collect();
+        println!("{name:<36} fails {:>3} case(s): {ids:?}", failed.len());
+        if !matches!(kind, Kind::StartLatency(_)) {
+            problems.extend(describe(name, &failed));
         }
-        println!("{name:<30} fails {:>3} case(s): {:?}", failed.len(), failed);
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

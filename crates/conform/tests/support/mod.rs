@@ -10,6 +10,7 @@
     clippy::panic
 )]
 
+pub mod legal;
 pub mod mutants;
 pub mod psd4xx_mutants;
 pub mod psd4xx_variants;
