@@ -225,7 +225,7 @@ fn replay_files_replay_byte_for_byte() {
     assert!(
         r.steps
             .iter()
-            .all(|s| matches!(s.action, Action::Cyclic(_))),
+            .all(|s| matches!(s.action, Action::Psd4xx(_))),
         "{text}"
     );
     assert!(text.contains("\"do\": \"pkw\""), "{text}");

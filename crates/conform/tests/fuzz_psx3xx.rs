@@ -13,9 +13,10 @@
 mod support;
 
 use drivespec_conform::cyclic::{LocalPeer, Server};
-use drivespec_conform::fuzz::{self, Action, CyclicStep, Device, FindingClass, Options, Replay};
+use drivespec_conform::fuzz::{self, Action, Device, FindingClass, Options, Replay};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
+use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_spec::FamilyId;
 use std::time::Instant;
 use support::mutants::spec;
@@ -238,7 +239,7 @@ fn replay_files_replay_byte_for_byte() {
     assert!(
         r.steps
             .iter()
-            .any(|s| matches!(s.action, Action::Cyclic(CyclicStep::IsduWrite { .. }))),
+            .any(|s| matches!(s.action, Action::Psx3xx(PsxStep::IsduWrite { .. }))),
         "{text}"
     );
     assert!(text.contains("\"do\": \"isdu-write\""), "{text}");

@@ -3,7 +3,7 @@
 //! failed case run becomes a finding (README "Cyclic-exchange protocol", "Fuzzing").
 
 use super::engine::{self, Fault, Target, Trial};
-use super::replay::{Action, CyclicStep, FindingClass, Start, Step};
+use super::replay::{FamilyStep, FindingClass, Start, Step};
 use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef};
 use crate::cyclic::{Env, PeerError};
 use crate::cyclic_session::{CyclicFamily, CyclicSession};
@@ -28,34 +28,14 @@ pub(crate) const MAX_STEP_CYCLES: u32 = 60_000;
 /// Longest `advance` step (10 min).
 pub(crate) const MAX_ADVANCE_US: u64 = 600_000_000;
 
-/// The kind of an injection: the first word of its `ENV` line (`jam`, `link`, …).
-pub(crate) fn env_kind(env: &Env) -> String {
-    env.to_string()
-        .split(' ')
-        .next()
-        .unwrap_or_default()
-        .to_owned()
+/// The kind of an injection: the first word of its `ENV` text (`jam`, `link`, …).
+pub(crate) fn env_kind(env: &str) -> String {
+    env.split(' ').next().unwrap_or_default().to_owned()
 }
 
-/// What kind of step a fuzz step is, for signatures: `own` names the family's steps, the
-/// steps every cyclic family has are named here.
-pub(crate) fn kind(s: Option<&Step>, own: fn(&CyclicStep) -> Option<String>) -> String {
-    let Some(action) = s.map(|s| &s.action) else {
-        return "start".to_owned();
-    };
-    let Action::Cyclic(c) = action else {
-        return "not-cyclic".to_owned();
-    };
-    if let Some(name) = own(c) {
-        return name;
-    }
-    match c {
-        CyclicStep::Env(env) => format!("env-{}", env_kind(env)),
-        CyclicStep::Hold { .. } => "hold".to_owned(),
-        CyclicStep::Until { .. } => "until".to_owned(),
-        CyclicStep::Advance { .. } => "advance".to_owned(),
-        _ => "cyclic".to_owned(),
-    }
+/// The signature name of an `env` step: `env-` and the injection's kind.
+pub(crate) fn env_signature(env: &str) -> String {
+    format!("env-{}", env_kind(env))
 }
 
 /// The trial of a case run: none when it passed; otherwise a crash when the transport failed,
@@ -66,7 +46,7 @@ pub(crate) fn trial(
     peer_error: Option<PeerError>,
     steps: &[Step],
     family: &Family,
-    own: fn(&CyclicStep) -> Option<String>,
+    kind: impl FnOnce(usize) -> String,
     differs: impl FnOnce(&CaseRun, usize) -> String,
 ) -> Trial {
     let Outcome::Fail(mut failure) = run.outcome.clone() else {
@@ -94,7 +74,7 @@ pub(crate) fn trial(
         failure.message = format!("{} ({e})", failure.message);
     }
     run.outcome = Outcome::Fail(failure.clone());
-    let signature = format!("{}/{}{detail}", class.as_str(), kind(steps.get(step), own));
+    let signature = format!("{}/{}{detail}", class.as_str(), kind(step));
     Trial {
         run,
         fault: Some(Fault {
@@ -111,14 +91,20 @@ pub(crate) fn trial(
 pub(crate) trait CyclicFuzz<'s> {
     /// The family the session runs.
     type Family: CyclicFamily<'s>;
+    /// The family's step type.
+    type Step: FamilyStep;
     /// A new sequence.
     fn generate(&mut self, rng: &mut Rng) -> Vec<Step>;
-    /// The case a sequence runs as.
-    fn case(&self, steps: &[Step]) -> (CaseInfo, <Self::Family as CyclicFamily<'s>>::Case);
+    /// The case a sequence runs as; `own` holds the family step of each of `steps`.
+    fn case(
+        &self,
+        steps: &[Step],
+        own: &[&Self::Step],
+    ) -> (CaseInfo, <Self::Family as CyclicFamily<'s>>::Case);
     /// Which parts of the failing step's answer differ.
     fn differs(&self, run: &CaseRun, step: usize) -> String;
-    /// The signature names of the family's own steps ([`kind`] names the shared ones).
-    fn own_kind(c: &CyclicStep) -> Option<String>;
+    /// The signature name of a step.
+    fn kind(s: &Self::Step) -> String;
     /// The family's spec.
     fn spec(&self) -> &Family;
 }
@@ -141,7 +127,7 @@ impl<'a, 's, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> CyclicTarget<'a
         let taken: Vec<String> = envs
             .iter()
             .filter(|e| session.takes(**e))
-            .map(env_kind)
+            .map(|e| env_kind(&e.to_string()))
             .collect();
         Ok(CyclicTarget {
             session,
@@ -175,7 +161,17 @@ impl<'s, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> Target for CyclicTa
     fn warm_up(&mut self) {}
 
     fn run(&mut self, steps: &[Step]) -> Trial {
-        let (info, case) = self.part.case(steps);
+        let own = match engine::own_steps::<P::Step>(steps) {
+            Ok(own) => own,
+            // Not a finding of the device: the sequence itself is of another family.
+            Err(e) => {
+                return Trial {
+                    run: e.failed_run(),
+                    fault: None,
+                }
+            }
+        };
+        let (info, case) = self.part.case(steps, &own);
         let run = self.session.run_case(&info, &case);
         let peer_error = self.session.take_peer_error();
         trial(
@@ -183,7 +179,10 @@ impl<'s, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> Target for CyclicTa
             peer_error,
             steps,
             self.part.spec(),
-            P::own_kind,
+            |step| {
+                own.get(step)
+                    .map_or_else(|| "start".to_owned(), |s| P::kind(s))
+            },
             |run, step| self.part.differs(run, step),
         )
     }

@@ -7,9 +7,9 @@
 //! decides when `--duration` stops the loop.
 
 use super::ddmin::ddmin;
-use super::replay::{Action, FindingClass, Start, Step};
+use super::replay::{Action, FamilyStep, FindingClass, Start, Step};
 use super::stats::Stats;
-use crate::case::{CaseRun, Failure, RequirementRef};
+use crate::case::{CaseRun, Failure, Outcome, RequirementRef};
 use crate::link::{Caps, LinkError};
 use crate::rng::Rng;
 use drivespec_hpd::step::Step as HpdStep;
@@ -435,8 +435,57 @@ pub(crate) fn pick<'x, T>(rng: &mut Rng, items: &'x [T]) -> Option<&'x T> {
 pub(crate) fn is_exchange(s: &Step) -> bool {
     matches!(
         s.action,
-        Action::Hpd(HpdStep::Exchange { .. } | HpdStep::Send { .. }) | Action::Cyclic(_)
+        Action::Hpd(HpdStep::Exchange { .. } | HpdStep::Send { .. })
+            | Action::Psd4xx(_)
+            | Action::Psx3xx(_)
     )
+}
+
+/// A step of another family in a sequence run on a target.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("step {index} ({text:?}) is a {step} step, not a {family} step")]
+pub(crate) struct OtherFamilyStep {
+    /// Index of the step in the sequence.
+    pub index: usize,
+    /// The step's text.
+    pub text: String,
+    /// The step's family.
+    pub step: FamilyId,
+    /// The target's family.
+    pub family: FamilyId,
+}
+
+impl OtherFamilyStep {
+    /// The run of a sequence that holds this step: failed before anything was sent.
+    pub(crate) fn failed_run(&self) -> CaseRun {
+        CaseRun {
+            outcome: Outcome::Fail(Failure {
+                step: Some(self.index),
+                message: self.to_string(),
+                expected: format!("a {} step", self.family),
+                got: format!("a {} step", self.step),
+                requirements: Vec::new(),
+            }),
+            evidence: Vec::new(),
+            elapsed_us: 0,
+        }
+    }
+}
+
+/// The family steps of a sequence, or the first step of another family.
+pub(crate) fn own_steps<S: FamilyStep>(steps: &[Step]) -> Result<Vec<&S>, OtherFamilyStep> {
+    steps
+        .iter()
+        .enumerate()
+        .map(|(index, s)| {
+            S::of(&s.action).ok_or_else(|| OtherFamilyStep {
+                index,
+                text: s.text.clone(),
+                step: s.action.family(),
+                family: S::FAMILY,
+            })
+        })
+        .collect()
 }
 
 /// Fails with the IDs a generator's templates name that `family` lacks.

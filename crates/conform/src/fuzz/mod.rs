@@ -28,8 +28,7 @@ mod stats;
 
 pub use output::{json as report_json, Finding};
 pub use replay::{
-    Action, CyclicStep, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start, Step,
-    REPLAY_FORMAT,
+    Action, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start, Step, REPLAY_FORMAT,
 };
 pub use stats::{FindingSummary, Stats, STATS_SCHEMA};
 

@@ -2,15 +2,22 @@
 //! `crates/conform/README.md`, "Fuzzing"): the steps of a sequence, what each exchange gave
 //! when the file was written, and the finding it reproduces.
 //!
-//! Loading never panics: unknown keys, a wrong format name, bad hex or a step without the
-//! fields its action needs are errors naming the step.
+//! A step is its family's step type (`drivespec_hpd::step::Step`,
+//! `drivespec_psd4xx::step::Step`, `drivespec_psx3xx::step::Step`) with the keys `class`,
+//! `text` and `requirements` beside it; the file's `family` says which.
+//!
+//! Loading never panics: unknown keys, a wrong format name, bad hex, an injection the
+//! cyclic-exchange protocol does not know or a step without the fields its action needs are
+//! errors naming the step.
 
 use crate::case::Record;
-use crate::cyclic::{Env, Request};
+use crate::cyclic::Request;
 use crate::link::Micros;
 use drivespec_hpd::step::Step as HpdStep;
-use drivespec_spec::hex::{parse_hex, to_hex};
+use drivespec_psd4xx::step::Step as PsdStep;
+use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_spec::FamilyId;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -22,167 +29,30 @@ pub const REPLAY_FORMAT: &str = "drivespec-fuzz-replay/1";
 pub enum Action {
     /// An HPD step (exchange, send, listen, power-cycle, inputs, bit-rate).
     Hpd(HpdStep),
-    /// A step of the cyclic-exchange protocol (PSD4xx, PSx3xx; README "Cyclic-exchange
-    /// protocol").
-    Cyclic(CyclicStep),
-}
-
-/// What one step of a cyclic-exchange sequence does; device and reference get the same
-/// requests, every cycle's input image and every reply is judged (PSD4xx manual 3.5–3.9;
-/// PSx3xx manual 3.1, 3.3).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum CyclicStep {
-    /// New control word and/or target (absent: unchanged), then one cycle (3.5.1).
-    Process {
-        /// Control word (par 32).
-        control: Option<u16>,
-        /// Target value (par 33).
-        target: Option<i32>,
-    },
-    /// New control word (absent: unchanged) and a target this far from the reference's actual
-    /// position, then one cycle.
-    Offset {
-        /// Control word (par 32).
-        control: Option<u16>,
-        /// Target minus actual position (increments).
-        offset: i64,
-    },
-    /// A PKW block, any code (3.8), cycled until the reference answers it (at most 8 cycles).
-    Pkw {
-        /// Command code AK (0–15).
-        ak: u8,
-        /// SPM bit.
-        spm: bool,
-        /// Parameter number.
-        pnu: u16,
-        /// Subindex word IND.
-        ind: u16,
-        /// Parameter value PWE.
-        pwe: u32,
-    },
-    /// Cycles with the outputs unchanged.
-    Hold {
-        /// How many.
-        cycles: u32,
-    },
-    /// Cycles until the reference runs (`true`) or stands still, at most `max`.
-    Until {
-        /// Wait for "drive is running" set (true) or a standstill (false).
-        running: bool,
-        /// Most cycles.
-        max: u32,
-    },
-    /// An acyclic record read (3.2.2).
-    RecordRead {
-        /// Record index (= parameter number).
-        index: u16,
-    },
-    /// An acyclic record write, control byte first (3.2.2).
-    RecordWrite {
-        /// Record index (= parameter number).
-        index: u16,
-        /// The data.
-        data: Vec<u8>,
-    },
-    /// An environment injection (`ENV`).
-    Env(Env),
-    /// Time passes without a bus cycle (`ADVANCE`).
-    Advance {
-        /// How long (µs).
-        us: Micros,
-    },
-    /// A PSx3xx process output in `format`, then one cycle (PSx3xx manual 3.3.1): format 0
-    /// sends `control` as the time-stamp code with `stamp`, format 1 the control word and
-    /// `target`, format 2 also `speed`.
-    ProcessData {
-        /// Output format (0, 1, 2).
-        format: u8,
-        /// Control word (formats 1, 2) or time-stamp code (format 0).
-        control: u16,
-        /// Target position (formats 1, 2).
-        target: i32,
-        /// Target speed (format 2).
-        speed: i16,
-        /// Time stamp (format 0).
-        stamp: u16,
-    },
-    /// A PSx3xx ISDU read between two cycles (PSx3xx manual 3.1).
-    IsduRead {
-        /// ISDU index.
-        index: u16,
-        /// Sub-index.
-        subindex: u8,
-    },
-    /// A PSx3xx ISDU write between two cycles, most significant octet first (3.1).
-    IsduWrite {
-        /// ISDU index.
-        index: u16,
-        /// Sub-index.
-        subindex: u8,
-        /// The octets.
-        data: Vec<u8>,
-    },
-}
-
-impl CyclicStep {
-    fn name(&self) -> &'static str {
-        match self {
-            CyclicStep::Process { .. } => "process",
-            CyclicStep::Offset { .. } => "offset",
-            CyclicStep::Pkw { .. } => "pkw",
-            CyclicStep::Hold { .. } => "hold",
-            CyclicStep::Until { .. } => "until",
-            CyclicStep::RecordRead { .. } => "record-read",
-            CyclicStep::RecordWrite { .. } => "record-write",
-            CyclicStep::Env(_) => "env",
-            CyclicStep::Advance { .. } => "advance",
-            CyclicStep::ProcessData { .. } => "pd-out",
-            CyclicStep::IsduRead { .. } => "isdu-read",
-            CyclicStep::IsduWrite { .. } => "isdu-write",
-        }
-    }
-
-    /// The family a step belongs to; None for steps every cyclic family has.
-    pub fn family(&self) -> Option<FamilyId> {
-        match self {
-            CyclicStep::Process { .. }
-            | CyclicStep::Offset { .. }
-            | CyclicStep::Pkw { .. }
-            | CyclicStep::RecordRead { .. }
-            | CyclicStep::RecordWrite { .. } => Some(FamilyId::Psd4xx),
-            CyclicStep::ProcessData { .. }
-            | CyclicStep::IsduRead { .. }
-            | CyclicStep::IsduWrite { .. } => Some(FamilyId::Psx3xx),
-            CyclicStep::Hold { .. }
-            | CyclicStep::Until { .. }
-            | CyclicStep::Env(_)
-            | CyclicStep::Advance { .. } => None,
-        }
-    }
-}
-
-/// The PKW block of a `pkw` step in the file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PkwFile {
-    ak: u8,
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    spm: bool,
-    pnu: u16,
-    #[serde(default)]
-    ind: u16,
-    #[serde(default)]
-    pwe: u32,
+    /// A PSD4xx step (process, offset, pkw, record-read, record-write, hold, until, env,
+    /// advance; PSD4xx manual 3.5–3.9).
+    Psd4xx(PsdStep),
+    /// A PSx3xx step (pd-out, hold, until, advance, isdu-read, isdu-write, env; PSx3xx
+    /// manual 3.1, 3.3).
+    Psx3xx(PsxStep),
 }
 
 impl Action {
-    /// The bytes the step puts on the line, if any (a record write: its data).
+    /// The family the step belongs to.
+    pub fn family(&self) -> FamilyId {
+        match self {
+            Action::Hpd(_) => FamilyId::Hpd,
+            Action::Psd4xx(_) => FamilyId::Psd4xx,
+            Action::Psx3xx(_) => FamilyId::Psx3xx,
+        }
+    }
+
+    /// The bytes the step puts on the line, if any (a record or ISDU write: its data).
     pub fn bytes(&self) -> Option<&[u8]> {
         match self {
             Action::Hpd(h) => h.bytes(),
-            Action::Cyclic(
-                CyclicStep::RecordWrite { data, .. } | CyclicStep::IsduWrite { data, .. },
-            ) => Some(data),
+            Action::Psd4xx(PsdStep::RecordWrite { hex, .. }) => Some(hex),
+            Action::Psx3xx(PsxStep::IsduWrite { data, .. }) => Some(data),
             _ => None,
         }
     }
@@ -191,15 +61,15 @@ impl Action {
     pub fn with_bytes(&self, new: Vec<u8>) -> Action {
         match self {
             Action::Hpd(h) => Action::Hpd(h.with_bytes(new)),
-            Action::Cyclic(CyclicStep::RecordWrite { index, .. }) => {
-                Action::Cyclic(CyclicStep::RecordWrite {
+            Action::Psd4xx(PsdStep::RecordWrite { index, .. }) => {
+                Action::Psd4xx(PsdStep::RecordWrite {
                     index: *index,
-                    data: new,
+                    hex: new,
                 })
             }
-            Action::Cyclic(CyclicStep::IsduWrite {
+            Action::Psx3xx(PsxStep::IsduWrite {
                 index, subindex, ..
-            }) => Action::Cyclic(CyclicStep::IsduWrite {
+            }) => Action::Psx3xx(PsxStep::IsduWrite {
                 index: *index,
                 subindex: *subindex,
                 data: new,
@@ -208,10 +78,60 @@ impl Action {
         }
     }
 
-    fn name(&self) -> &'static str {
+    /// The step's `do` key.
+    pub fn name(&self) -> &'static str {
         match self {
             Action::Hpd(h) => h.name(),
-            Action::Cyclic(c) => c.name(),
+            Action::Psd4xx(p) => p.name(),
+            Action::Psx3xx(p) => p.name(),
+        }
+    }
+
+    /// The injection of an `env` step.
+    fn env_mut(&mut self) -> Option<&mut String> {
+        match self {
+            Action::Psd4xx(PsdStep::Env { env }) | Action::Psx3xx(PsxStep::Env { env }) => {
+                Some(env)
+            }
+            _ => None,
+        }
+    }
+}
+
+/// A family's step type, as one [`Action`] variant holds it.
+pub trait FamilyStep {
+    /// The family.
+    const FAMILY: FamilyId;
+    /// The step `a` holds, None when `a` is of another family.
+    fn of(a: &Action) -> Option<&Self>;
+}
+
+impl FamilyStep for HpdStep {
+    const FAMILY: FamilyId = FamilyId::Hpd;
+    fn of(a: &Action) -> Option<&HpdStep> {
+        match a {
+            Action::Hpd(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+impl FamilyStep for PsdStep {
+    const FAMILY: FamilyId = FamilyId::Psd4xx;
+    fn of(a: &Action) -> Option<&PsdStep> {
+        match a {
+            Action::Psd4xx(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+impl FamilyStep for PsxStep {
+    const FAMILY: FamilyId = FamilyId::Psx3xx;
+    fn of(a: &Action) -> Option<&PsxStep> {
+        match a {
+            Action::Psx3xx(s) => Some(s),
+            _ => None,
         }
     }
 }
@@ -431,11 +351,11 @@ struct ReplayFile<S> {
     exchanges: Vec<Observed>,
 }
 
-/// The file form of an HPD [`Step`]: the step's keys, then class, text and requirements.
+/// The file form of a [`Step`]: the family step's keys, then class, text and requirements.
 #[derive(Debug, Serialize, Deserialize)]
-struct HpdStepFile {
+struct StepFile<S> {
     #[serde(flatten)]
-    step: HpdStep,
+    step: S,
     #[serde(default)]
     class: String,
     #[serde(default, skip_serializing_if = "String::is_empty")]
@@ -444,13 +364,13 @@ struct HpdStepFile {
     requirements: Vec<String>,
 }
 
-impl HpdStepFile {
-    fn into_step(self) -> Step {
-        Step {
-            action: Action::Hpd(self.step),
-            class: self.class,
-            text: self.text,
-            requirements: self.requirements,
+impl<S> StepFile<S> {
+    fn of(s: &Step, step: S) -> StepFile<S> {
+        StepFile {
+            step,
+            class: s.class.clone(),
+            text: s.text.clone(),
+            requirements: s.requirements.clone(),
         }
     }
 }
@@ -458,278 +378,82 @@ impl HpdStepFile {
 /// A step as written: in the form of its family.
 #[derive(Debug, Serialize)]
 #[serde(untagged)]
-enum StepOut {
-    Hpd(HpdStepFile),
-    Cyclic(StepFile),
+enum StepOut<'a> {
+    Hpd(StepFile<&'a HpdStep>),
+    Psd4xx(StepFile<&'a PsdStep>),
+    Psx3xx(StepFile<&'a PsxStep>),
 }
 
-impl StepOut {
-    fn of(s: &Step) -> StepOut {
+impl StepOut<'_> {
+    fn of(s: &Step) -> StepOut<'_> {
         match &s.action {
-            Action::Hpd(h) => StepOut::Hpd(HpdStepFile {
-                step: h.clone(),
-                class: s.class.clone(),
-                text: s.text.clone(),
-                requirements: s.requirements.clone(),
-            }),
-            Action::Cyclic(_) => StepOut::Cyclic(StepFile::of(s)),
+            Action::Hpd(h) => StepOut::Hpd(StepFile::of(s, h)),
+            Action::Psd4xx(p) => StepOut::Psd4xx(StepFile::of(s, p)),
+            Action::Psx3xx(p) => StepOut::Psx3xx(StepFile::of(s, p)),
         }
     }
 }
 
-/// Step `index` of a `family` file; a step that reads as one of another family is
-/// [`ReplayError::OtherFamily`].
+/// `v` read as a step of type `S`, wrapped by `action`.
+fn read_as<S: DeserializeOwned>(
+    v: &serde_json::Value,
+    action: fn(S) -> Action,
+) -> Result<Step, serde_json::Error> {
+    StepFile::<S>::deserialize(v).map(|f| Step {
+        action: action(f.step),
+        class: f.class,
+        text: f.text,
+        requirements: f.requirements,
+    })
+}
+
+/// `v` read as a step of `family`.
+fn read_in(family: FamilyId, v: &serde_json::Value) -> Result<Step, serde_json::Error> {
+    match family {
+        FamilyId::Hpd => read_as(v, Action::Hpd),
+        FamilyId::Psd4xx => read_as(v, Action::Psd4xx),
+        FamilyId::Psx3xx => read_as(v, Action::Psx3xx),
+    }
+}
+
+/// Step `index` of a `family` file, its injection (if any) in the protocol's own spelling; a
+/// step that reads as one of another family is [`ReplayError::OtherFamily`].
 fn read_step(
     family: FamilyId,
     index: usize,
     v: &serde_json::Value,
     file: &str,
 ) -> Result<Step, ReplayError> {
-    let hpd = HpdStepFile::deserialize(v)
-        .map(HpdStepFile::into_step)
-        .map_err(|e| format!("step {index}: {e}"));
-    let cyclic = StepFile::deserialize(v)
-        .map_err(|e| format!("step {index}: {e}"))
-        .and_then(|f| f.step(index));
-    let (own, other) = if family == FamilyId::Hpd {
-        (hpd, cyclic.ok())
-    } else {
-        (cyclic, hpd.ok())
+    let bad = |why: String| ReplayError::Format {
+        file: file.to_owned(),
+        why,
     };
-    own.map_err(|why| match other {
-        Some(s) => ReplayError::OtherFamily {
-            file: file.to_owned(),
-            step: index,
-            action: s.action.name().to_owned(),
-            family,
-        },
-        None => ReplayError::Format {
-            file: file.to_owned(),
-            why,
-        },
-    })
-}
-
-/// The file form of a cyclic [`Step`]: `do` names the action; the other keys are the action's.
-#[derive(Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct StepFile {
-    #[serde(rename = "do")]
-    action: String,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    hex: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    us: Option<Micros>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    control: Option<u16>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    target: Option<i32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    offset: Option<i64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pkw: Option<PkwFile>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    cycles: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    running: Option<bool>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    max: Option<u32>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    index: Option<u16>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    subindex: Option<u8>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    format: Option<u8>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    speed: Option<i16>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    stamp: Option<u16>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    env: Option<String>,
-    #[serde(default)]
-    class: String,
-    #[serde(default, skip_serializing_if = "String::is_empty")]
-    text: String,
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    requirements: Vec<String>,
-}
-
-/// `v`, or an error naming the step, its action and the missing key.
-fn need<T>(v: Option<T>, index: usize, action: &str, key: &str) -> Result<T, String> {
-    v.ok_or_else(|| format!("step {index}: `{action}` needs `{key}`"))
-}
-
-impl StepFile {
-    fn of(s: &Step) -> StepFile {
-        let mut f = StepFile {
-            action: s.action.name().to_owned(),
-            hex: s.action.bytes().map(to_hex),
-            us: None,
-            control: None,
-            target: None,
-            offset: None,
-            pkw: None,
-            cycles: None,
-            running: None,
-            max: None,
-            index: None,
-            subindex: None,
-            format: None,
-            speed: None,
-            stamp: None,
-            env: None,
-            class: s.class.clone(),
-            text: s.text.clone(),
-            requirements: s.requirements.clone(),
-        };
-        match &s.action {
-            Action::Cyclic(c) => match c {
-                CyclicStep::Process { control, target } => {
-                    f.control = *control;
-                    f.target = *target;
-                }
-                CyclicStep::Offset { control, offset } => {
-                    f.control = *control;
-                    f.offset = Some(*offset);
-                }
-                CyclicStep::Pkw {
-                    ak,
-                    spm,
-                    pnu,
-                    ind,
-                    pwe,
-                } => {
-                    f.pkw = Some(PkwFile {
-                        ak: *ak,
-                        spm: *spm,
-                        pnu: *pnu,
-                        ind: *ind,
-                        pwe: *pwe,
-                    })
-                }
-                CyclicStep::Hold { cycles } => f.cycles = Some(*cycles),
-                CyclicStep::Until { running, max } => {
-                    f.running = Some(*running);
-                    f.max = Some(*max);
-                }
-                CyclicStep::RecordRead { index } | CyclicStep::RecordWrite { index, .. } => {
-                    f.index = Some(*index)
-                }
-                CyclicStep::Env(env) => f.env = Some(env.to_string()),
-                CyclicStep::Advance { us } => f.us = Some(*us),
-                CyclicStep::ProcessData {
-                    format,
-                    control,
-                    target,
-                    speed,
-                    stamp,
-                } => {
-                    f.format = Some(*format);
-                    f.control = Some(*control);
-                    match format {
-                        0 => f.stamp = Some(*stamp),
-                        1 => f.target = Some(*target),
-                        _ => {
-                            f.target = Some(*target);
-                            f.speed = Some(*speed);
-                        }
-                    }
-                }
-                CyclicStep::IsduRead { index, subindex }
-                | CyclicStep::IsduWrite {
-                    index, subindex, ..
-                } => {
-                    f.index = Some(*index);
-                    f.subindex = Some(*subindex);
-                }
+    let mut step = read_in(family, v).map_err(|e| {
+        let other = FamilyId::ALL
+            .into_iter()
+            .filter(|f| *f != family)
+            .find_map(|f| read_in(f, v).ok());
+        match other {
+            Some(s) => ReplayError::OtherFamily {
+                file: file.to_owned(),
+                step: index,
+                action: s.action.name().to_owned(),
+                family,
             },
-            // HPD steps are written as [`HpdStepFile`].
-            Action::Hpd(_) => {}
+            None => bad(format!("step {index}: {e}")),
         }
-        f
+    })?;
+    if let Some(text) = step.action.env_mut() {
+        match Request::parse(&format!("ENV 0 {text}")) {
+            Ok(Request::Env { env, .. }) => *text = env.to_string(),
+            _ => {
+                return Err(bad(format!(
+                    "step {index}: env {text:?}: not an injection (e.g. \"jam 1\")"
+                )))
+            }
+        }
     }
-
-    fn step(self, index: usize) -> Result<Step, String> {
-        let action_name = self.action.clone();
-        let bytes = || -> Result<Vec<u8>, String> {
-            let hex = self
-                .hex
-                .as_deref()
-                .ok_or_else(|| format!("step {index}: `{}` needs `hex`", self.action))?;
-            parse_hex(hex).map_err(|e| format!("step {index}: hex: {e}"))
-        };
-        let action = match self.action.as_str() {
-            "process" => Action::Cyclic(CyclicStep::Process {
-                control: self.control,
-                target: self.target,
-            }),
-            "offset" => Action::Cyclic(CyclicStep::Offset {
-                control: self.control,
-                offset: need(self.offset, index, &action_name, "offset")?,
-            }),
-            "pkw" => {
-                let p = need(self.pkw, index, &action_name, "pkw")?;
-                Action::Cyclic(CyclicStep::Pkw {
-                    ak: p.ak,
-                    spm: p.spm,
-                    pnu: p.pnu,
-                    ind: p.ind,
-                    pwe: p.pwe,
-                })
-            }
-            "hold" => Action::Cyclic(CyclicStep::Hold {
-                cycles: need(self.cycles, index, &action_name, "cycles")?,
-            }),
-            "until" => Action::Cyclic(CyclicStep::Until {
-                running: need(self.running, index, &action_name, "running")?,
-                max: need(self.max, index, &action_name, "max")?,
-            }),
-            "record-read" => Action::Cyclic(CyclicStep::RecordRead {
-                index: need(self.index, index, &action_name, "index")?,
-            }),
-            "record-write" => Action::Cyclic(CyclicStep::RecordWrite {
-                index: need(self.index, index, &action_name, "index")?,
-                data: bytes()?,
-            }),
-            "env" => {
-                let text = need(self.env.clone(), index, &action_name, "env")?;
-                match Request::parse(&format!("ENV 0 {text}")) {
-                    Ok(Request::Env { env, .. }) => Action::Cyclic(CyclicStep::Env(env)),
-                    _ => return Err(format!("step {index}: env {text:?}: not an injection (e.g. \"jam 1\")")),
-                }
-            }
-            "advance" => Action::Cyclic(CyclicStep::Advance {
-                us: need(self.us, index, &action_name, "us")?,
-            }),
-            "pd-out" => Action::Cyclic(CyclicStep::ProcessData {
-                format: need(self.format, index, &action_name, "format")?,
-                control: need(self.control, index, &action_name, "control")?,
-                target: self.target.unwrap_or(0),
-                speed: self.speed.unwrap_or(0),
-                stamp: self.stamp.unwrap_or(0),
-            }),
-            "isdu-read" => Action::Cyclic(CyclicStep::IsduRead {
-                index: need(self.index, index, &action_name, "index")?,
-                subindex: self.subindex.unwrap_or(0),
-            }),
-            "isdu-write" => Action::Cyclic(CyclicStep::IsduWrite {
-                index: need(self.index, index, &action_name, "index")?,
-                subindex: self.subindex.unwrap_or(0),
-                data: bytes()?,
-            }),
-            other => {
-                return Err(format!(
-                    "step {index}: unknown action {other:?} (hpd: exchange, send, listen, listen-timeout, listen-half-timeout, power-cycle, inputs, bit-rate; cyclic: hold, until, env, advance; psd4xx: process, offset, pkw, record-read, record-write; psx3xx: pd-out, isdu-read, isdu-write)"
-                ))
-            }
-        };
-        Ok(Step {
-            action,
-            class: self.class,
-            text: self.text,
-            requirements: self.requirements,
-        })
-    }
+    Ok(step)
 }
 
 impl Replay {
@@ -776,19 +500,6 @@ impl Replay {
             .enumerate()
             .map(|(i, v)| read_step(f.family, i, v, file))
             .collect::<Result<Vec<Step>, ReplayError>>()?;
-        // Cyclic steps of another family (PSD4xx records in a PSx3xx file) are refused too.
-        let foreign = |a: &Action| match a {
-            Action::Cyclic(c) => c.family().is_some_and(|x| x != f.family),
-            Action::Hpd(_) => false,
-        };
-        if let Some((i, s)) = steps.iter().enumerate().find(|(_, s)| foreign(&s.action)) {
-            return Err(ReplayError::OtherFamily {
-                file: file.to_owned(),
-                step: i,
-                action: s.action.name().to_owned(),
-                family: f.family,
-            });
-        }
         if let Some(fi) = &f.finding {
             if fi.step >= steps.len() {
                 return Err(bad(format!(
@@ -836,6 +547,7 @@ mod tests {
     #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
     use super::*;
     use drivespec_hpd::step::Compare;
+    use drivespec_psd4xx::step::PkwBlock;
 
     fn sample() -> Replay {
         Replay {
@@ -901,117 +613,127 @@ mod tests {
         assert_eq!(r.start, Start::Fresh);
     }
 
-    #[test]
-    fn cyclic_steps_round_trip_and_stay_in_their_family() {
-        let step = |c: CyclicStep| Step {
-            action: Action::Cyclic(c),
+    fn psd(p: PsdStep) -> Step {
+        Step {
+            action: Action::Psd4xx(p),
             class: "x".into(),
             text: String::new(),
             requirements: vec![],
-        };
+        }
+    }
+
+    fn psx(p: PsxStep) -> Step {
+        Step {
+            action: Action::Psx3xx(p),
+            class: "x".into(),
+            text: String::new(),
+            requirements: vec![],
+        }
+    }
+
+    #[test]
+    fn psd4xx_steps_round_trip_and_stay_in_their_family() {
         let r = Replay {
             family: FamilyId::Psd4xx,
             steps: vec![
-                step(CyclicStep::Process {
+                psd(PsdStep::Process {
                     control: Some(0x14),
                     target: Some(-4000),
                 }),
-                step(CyclicStep::Process {
+                psd(PsdStep::Process {
                     control: None,
                     target: None,
                 }),
-                step(CyclicStep::Offset {
+                psd(PsdStep::Offset {
                     control: Some(0x54),
                     offset: 12,
                 }),
-                step(CyclicStep::Pkw {
-                    ak: 15,
-                    spm: true,
-                    pnu: 2047,
-                    ind: 3,
-                    pwe: u32::MAX,
+                psd(PsdStep::Pkw {
+                    pkw: PkwBlock {
+                        ak: 15,
+                        spm: true,
+                        pnu: 2047,
+                        ind: 3,
+                        pwe: u32::MAX,
+                    },
                 }),
-                step(CyclicStep::Hold { cycles: 3 }),
-                step(CyclicStep::Until {
+                psd(PsdStep::Hold { cycles: 3 }),
+                psd(PsdStep::Until {
                     running: false,
                     max: 100,
                 }),
-                step(CyclicStep::RecordRead { index: 44 }),
-                step(CyclicStep::RecordWrite {
+                psd(PsdStep::RecordRead { index: 44 }),
+                psd(PsdStep::RecordWrite {
                     index: 44,
-                    data: vec![1, 0, 5],
+                    hex: vec![1, 0, 5],
                 }),
-                step(CyclicStep::Env(Env::Jam(true))),
-                step(CyclicStep::Env(Env::Link(
-                    drivespec_psd4xx::model::LinkEvent::IopsBad,
-                ))),
-                step(CyclicStep::Advance { us: 2_500_000 }),
+                psd(PsdStep::Env {
+                    env: "jam 1".into(),
+                }),
+                psd(PsdStep::Env {
+                    env: "link iops-bad".into(),
+                }),
+                psd(PsdStep::Advance { us: 2_500_000 }),
             ],
             ..sample()
         };
         let text = r.to_json();
         assert_eq!(Replay::from_json(&text, "x").unwrap(), r);
         assert!(text.contains("\"env\": \"link iops-bad\""), "{text}");
+        // The bytes of a record write are what minimisation shortens.
+        assert_eq!(r.steps[7].action.bytes(), Some(&[1u8, 0, 5][..]));
         // Cyclic steps in an HPD file, a bad injection or a missing key are refused.
         let hpd = text.replace("\"psd4xx\"", "\"hpd\"");
         assert!(Replay::from_json(&hpd, "x").is_err());
         let bad = text.replace("jam 1", "warp 9");
-        assert!(Replay::from_json(&bad, "x").is_err());
+        let e = Replay::from_json(&bad, "x").unwrap_err().to_string();
+        assert!(e.contains("step 8") && e.contains("warp 9"), "{e}");
         let bad = text.replace("\"cycles\": 3", "\"cylces\": 3");
         assert!(Replay::from_json(&bad, "x").is_err());
         let mut hpd_with_cyclic = sample();
-        hpd_with_cyclic
-            .steps
-            .push(step(CyclicStep::Hold { cycles: 1 }));
+        hpd_with_cyclic.steps.push(psd(PsdStep::Hold { cycles: 1 }));
         assert!(Replay::from_json(&hpd_with_cyclic.to_json(), "x").is_err());
     }
 
     #[test]
     fn psx3xx_steps_round_trip_and_stay_in_their_family() {
-        let step = |c: CyclicStep| Step {
-            action: Action::Cyclic(c),
-            class: "x".into(),
-            text: String::new(),
-            requirements: vec![],
-        };
         let r = Replay {
             family: FamilyId::Psx3xx,
             steps: vec![
-                step(CyclicStep::ProcessData {
+                psx(PsxStep::PdOut {
                     format: 0,
                     control: 3,
                     target: 0,
                     speed: 0,
                     stamp: 16_383,
                 }),
-                step(CyclicStep::ProcessData {
+                psx(PsxStep::PdOut {
                     format: 1,
                     control: 0x14,
                     target: -4000,
                     speed: 0,
                     stamp: 0,
                 }),
-                step(CyclicStep::ProcessData {
+                psx(PsxStep::PdOut {
                     format: 2,
                     control: 0x11,
                     target: 12,
                     speed: -1,
                     stamp: 0,
                 }),
-                step(CyclicStep::IsduRead {
+                psx(PsxStep::IsduRead {
                     index: 0,
                     subindex: 16,
                 }),
-                step(CyclicStep::IsduWrite {
+                psx(PsxStep::IsduWrite {
                     index: 116,
                     subindex: 0,
                     data: vec![2],
                 }),
-                step(CyclicStep::Env(Env::Keys {
-                    forward: true,
-                    reverse: false,
-                })),
-                step(CyclicStep::Hold { cycles: 2 }),
+                psx(PsxStep::Env {
+                    env: "keys forward".into(),
+                }),
+                psx(PsxStep::Hold { cycles: 2 }),
             ],
             ..sample()
         };
@@ -1021,17 +743,42 @@ mod tests {
         // The bytes of an ISDU write are what minimisation shortens.
         assert_eq!(r.steps[4].action.bytes(), Some(&[2u8][..]));
         // PSx3xx steps in a PSD4xx or HPD file, and PSD4xx steps in a PSx3xx file, are refused.
-        let psd = text.replace("\"psx3xx\"", "\"psd4xx\"");
-        assert!(Replay::from_json(&psd, "x").is_err());
+        let psd_file = text.replace("\"psx3xx\"", "\"psd4xx\"");
+        assert!(Replay::from_json(&psd_file, "x").is_err());
         let hpd = text.replace("\"psx3xx\"", "\"hpd\"");
         assert!(Replay::from_json(&hpd, "x").is_err());
         let mut with_record = r.clone();
         with_record
             .steps
-            .push(step(CyclicStep::RecordRead { index: 44 }));
+            .push(psd(PsdStep::RecordRead { index: 44 }));
         assert!(Replay::from_json(&with_record.to_json(), "x").is_err());
         let bad = text.replace("\"format\": 2,", "");
         assert!(Replay::from_json(&bad, "x").is_err());
+    }
+
+    #[test]
+    fn a_pd_out_step_in_a_psd4xx_file_is_refused_by_name() {
+        let mut r = Replay {
+            family: FamilyId::Psd4xx,
+            steps: vec![psd(PsdStep::Hold { cycles: 1 })],
+            ..sample()
+        };
+        r.steps.push(psx(PsxStep::PdOut {
+            format: 1,
+            control: 0x14,
+            target: 100,
+            speed: 0,
+            stamp: 0,
+        }));
+        let e = Replay::from_json(&r.to_json(), "x.json").unwrap_err();
+        assert!(
+            matches!(&e, ReplayError::OtherFamily { step: 1, action, family: FamilyId::Psd4xx, .. } if action == "pd-out"),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "x.json: step 1: `pd-out` is not a psd4xx step"
+        );
     }
 
     #[test]

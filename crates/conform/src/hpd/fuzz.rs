@@ -8,8 +8,8 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, Failure, Outcome, RequirementRef, Role};
-use crate::fuzz::engine::{self, Fault, Target, Trial};
+use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use crate::fuzz::engine::{self, Fault, OtherFamilyStep, Target, Trial};
 use crate::fuzz::replay::{Action, FindingClass, Start, Step};
 use crate::hpd::step::{Action as HAction, HpdCase, Step as HStep};
 use crate::hpd::{GenError, HpdSession, HpdSuite};
@@ -59,12 +59,12 @@ impl<'a, 's> HpdTarget<'a, 's> {
         })
     }
 
-    fn case(&self, steps: &[Step]) -> Result<(CaseInfo, HpdCase), NotHpdStep> {
-        let hsteps = steps
-            .iter()
-            .enumerate()
-            .map(|(index, s)| to_hpd(s).ok_or_else(|| NotHpdStep::new(index, s)))
-            .collect::<Result<Vec<HStep>, NotHpdStep>>()?;
+    fn case(&self, steps: &[Step]) -> Result<(CaseInfo, HpdCase), OtherFamilyStep> {
+        let hsteps: Vec<HStep> = engine::own_steps::<HAction>(steps)?
+            .into_iter()
+            .zip(steps)
+            .map(|(action, s)| to_hpd(action, s))
+            .collect();
         let info = CaseInfo {
             id: "hpd/fuzz/sequence".to_owned(),
             family: FamilyId::Hpd,
@@ -119,7 +119,7 @@ impl<'a, 's> HpdTarget<'a, 's> {
     }
 
     /// Runs the steps as one case; a step of another family fails the run with
-    /// [`NotHpdStep`] before anything is sent.
+    /// [`OtherFamilyStep`] before anything is sent.
     fn run_raw(&mut self, steps: &[Step]) -> CaseRun {
         match self.case(steps) {
             Ok((info, case)) => self.session.run_case(&info, &case, false),
@@ -140,58 +140,21 @@ impl<'a, 's> HpdTarget<'a, 's> {
                 HAction::Listen { .. } | HAction::ListenTimeout {} | HAction::ListenHalfTimeout {},
             )) => "listen".to_owned(),
             Some(Action::Hpd(h)) => h.name().to_owned(),
-            Some(Action::Cyclic(_)) => "cyclic".to_owned(),
+            Some(Action::Psd4xx(_) | Action::Psx3xx(_)) => "cyclic".to_owned(),
             None => "start".to_owned(),
         }
     }
 }
 
-/// A fuzz step of another family in an HPD sequence (a cyclic-exchange step).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("step {index} ({text:?}) is a cyclic-exchange step, not an HPD step")]
-pub(crate) struct NotHpdStep {
-    /// Index of the step in the sequence.
-    pub index: usize,
-    /// The step's text.
-    pub text: String,
-}
-
-impl NotHpdStep {
-    fn new(index: usize, s: &Step) -> NotHpdStep {
-        NotHpdStep {
-            index,
-            text: s.text.clone(),
-        }
-    }
-
-    /// The run of a sequence that holds this step: failed before anything was sent.
-    fn failed_run(&self) -> CaseRun {
-        CaseRun {
-            outcome: Outcome::Fail(Failure {
-                step: Some(self.index),
-                message: self.to_string(),
-                expected: "an HPD step".to_owned(),
-                got: "a cyclic-exchange step".to_owned(),
-                requirements: Vec::new(),
-            }),
-            evidence: Vec::new(),
-            elapsed_us: 0,
-        }
-    }
-}
-
-/// A fuzz step as a conformance step (judged); None for a step of another family.
-fn to_hpd(s: &Step) -> Option<HStep> {
-    let Action::Hpd(action) = &s.action else {
-        return None;
-    };
-    Some(HStep {
+/// A fuzz step as a conformance step (judged).
+fn to_hpd(action: &HAction, s: &Step) -> HStep {
+    HStep {
         role: Role::Check,
         action: action.clone(),
         golden: None,
         text: s.text.clone(),
         requirements: s.requirements.clone(),
-    })
+    }
 }
 
 impl Target for HpdTarget<'_, '_> {
@@ -339,7 +302,7 @@ impl Target for HpdTarget<'_, '_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fuzz::replay::CyclicStep;
+    use drivespec_psd4xx::step::Step as PsdStep;
 
     fn step(action: Action) -> Step {
         Step {
@@ -352,13 +315,14 @@ mod tests {
 
     #[test]
     fn a_cyclic_step_is_not_an_hpd_step() {
-        assert!(to_hpd(&step(Action::Hpd(HAction::Listen { us: 5 }))).is_some());
-        let cyclic = step(Action::Cyclic(CyclicStep::Hold { cycles: 1 }));
-        assert_eq!(to_hpd(&cyclic), None);
-        let e = NotHpdStep::new(3, &cyclic);
+        let listen = step(Action::Hpd(HAction::Listen { us: 5 }));
+        let cyclic = step(Action::Psd4xx(PsdStep::Hold { cycles: 1 }));
+        assert!(engine::own_steps::<HAction>(std::slice::from_ref(&listen)).is_ok());
+        let steps = [listen.clone(), listen.clone(), listen, cyclic];
+        let e = engine::own_steps::<HAction>(&steps).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "step 3 (\"a step\") is a cyclic-exchange step, not an HPD step"
+            "step 3 (\"a step\") is a psd4xx step, not a hpd step"
         );
         let run = e.failed_run();
         assert!(

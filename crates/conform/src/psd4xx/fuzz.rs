@@ -18,12 +18,12 @@ mod sequences;
 use crate::case::{CaseInfo, CaseRun, Role};
 use crate::cyclic::Peer;
 use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
-use crate::fuzz::replay::{Action, CyclicStep, Step};
+use crate::fuzz::replay::Step;
 use crate::psd4xx::cases::{PsdCase, StepDef, EXCHANGE, MOTION};
 use crate::psd4xx::{Psd4xx, Psd4xxSuite};
 use crate::rng::Rng;
 use crate::suite::SetupError;
-use drivespec_psd4xx::step::{PkwBlock, Step as PsdStep};
+use drivespec_psd4xx::step::Step as PsdStep;
 use drivespec_psd4xx::Input;
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Family, FamilyId, Level};
@@ -53,20 +53,21 @@ pub(crate) struct PsdFuzz<'a, 's> {
 
 impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
     type Family = Psd4xx<'a, 's>;
+    type Step = PsdStep;
 
     fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
         self.gen.sequence(rng)
     }
 
-    fn own_kind(c: &CyclicStep) -> Option<String> {
-        own_kind(c)
+    fn kind(s: &PsdStep) -> String {
+        kind(s)
     }
 
     fn spec(&self) -> &Family {
         self.suite.family()
     }
 
-    fn case(&self, steps: &[Step]) -> (CaseInfo, PsdCase) {
+    fn case(&self, steps: &[Step], own: &[&PsdStep]) -> (CaseInfo, PsdCase) {
         let mut requirements: Vec<String> = steps
             .iter()
             .flat_map(|s| s.requirements.iter().cloned())
@@ -83,20 +84,26 @@ impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
         };
         // The motion cases' tolerance as soon as anything may move the drive; the exchange
         // cases' otherwise.
-        let moves = steps.iter().any(|s| {
+        let moves = own.iter().any(|a| {
             !matches!(
-                s.action,
-                Action::Cyclic(
-                    CyclicStep::Pkw { .. }
-                        | CyclicStep::Hold { .. }
-                        | CyclicStep::RecordRead { .. }
-                        | CyclicStep::RecordWrite { .. }
-                        | CyclicStep::Advance { .. }
-                )
+                a,
+                PsdStep::Pkw { .. }
+                    | PsdStep::Hold { .. }
+                    | PsdStep::RecordRead { .. }
+                    | PsdStep::RecordWrite { .. }
+                    | PsdStep::Advance { .. }
             )
         });
         let case = PsdCase {
-            steps: steps.iter().map(to_case_step).collect(),
+            steps: own
+                .iter()
+                .zip(steps)
+                .map(|(a, s)| StepDef {
+                    role: Role::Check,
+                    text: s.text.clone(),
+                    action: bounded(a),
+                })
+                .collect(),
             tol: if moves { MOTION } else { EXCHANGE },
             plot: false,
         };
@@ -154,74 +161,29 @@ impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
     }
 }
 
-/// The signature names of the PSD4xx steps ([`cyclic_target::kind`] names the shared ones).
-fn own_kind(c: &CyclicStep) -> Option<String> {
-    let name = match c {
-        CyclicStep::Pkw { ak, .. } => return Some(format!("pkw-ak{ak}")),
-        CyclicStep::Process { .. } => "process",
-        CyclicStep::Offset { .. } => "offset",
-        CyclicStep::RecordRead { .. } => "record-read",
-        CyclicStep::RecordWrite { .. } => "record-write",
-        _ => return None,
-    };
-    Some(name.to_owned())
+/// The signature name of a PSD4xx step: `pkw-ak<code>`, `env-<kind>` or the step's name.
+fn kind(s: &PsdStep) -> String {
+    match s {
+        PsdStep::Pkw { pkw } => format!("pkw-ak{}", pkw.ak),
+        PsdStep::Env { env } => cyclic_target::env_signature(env),
+        other => other.name().to_owned(),
+    }
 }
 
-/// A fuzz step as a conformance step (judged). Steps of other protocols never reach here
-/// (replay files are checked on load); they would cycle once with the outputs unchanged.
-fn to_case_step(s: &Step) -> StepDef {
-    let action = match &s.action {
-        Action::Cyclic(c) => match c {
-            CyclicStep::Process { control, target } => PsdStep::Process {
-                control: *control,
-                target: *target,
-            },
-            CyclicStep::Offset { control, offset } => PsdStep::Offset {
-                control: *control,
-                offset: *offset,
-            },
-            CyclicStep::Pkw {
-                ak,
-                spm,
-                pnu,
-                ind,
-                pwe,
-            } => PsdStep::Pkw {
-                pkw: PkwBlock {
-                    ak: *ak,
-                    spm: *spm,
-                    pnu: *pnu,
-                    ind: *ind,
-                    pwe: *pwe,
-                },
-            },
-            CyclicStep::Hold { cycles } => PsdStep::Hold {
-                cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
-            },
-            CyclicStep::Until { running, max } => PsdStep::Until {
-                running: *running,
-                max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
-            },
-            CyclicStep::RecordRead { index } => PsdStep::RecordRead { index: *index },
-            CyclicStep::RecordWrite { index, data } => PsdStep::RecordWrite {
-                index: *index,
-                hex: data.clone(),
-            },
-            CyclicStep::Env(env) => PsdStep::Env {
-                env: env.to_string(),
-            },
-            CyclicStep::Advance { us } => PsdStep::Advance {
-                us: (*us).min(cyclic_target::MAX_ADVANCE_US),
-            },
-            CyclicStep::ProcessData { .. }
-            | CyclicStep::IsduRead { .. }
-            | CyclicStep::IsduWrite { .. } => PsdStep::Hold { cycles: 1 },
+/// A step within the bounds a replay file cannot exceed (most cycles of a wait, longest
+/// `advance`).
+fn bounded(s: &PsdStep) -> PsdStep {
+    match s {
+        PsdStep::Hold { cycles } => PsdStep::Hold {
+            cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
         },
-        _ => PsdStep::Hold { cycles: 1 },
-    };
-    StepDef {
-        role: Role::Check,
-        text: s.text.clone(),
-        action,
+        PsdStep::Until { running, max } => PsdStep::Until {
+            running: *running,
+            max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
+        },
+        PsdStep::Advance { us } => PsdStep::Advance {
+            us: (*us).min(cyclic_target::MAX_ADVANCE_US),
+        },
+        other => other.clone(),
     }
 }

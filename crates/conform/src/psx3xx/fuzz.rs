@@ -18,7 +18,7 @@ mod sequences;
 use crate::case::{CaseInfo, CaseRun, Role};
 use crate::cyclic::Peer;
 use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
-use crate::fuzz::replay::{Action, CyclicStep, Step};
+use crate::fuzz::replay::Step;
 use crate::psx3xx::cases::{PsxCase, StepDef, EXACT, MOTION};
 use crate::psx3xx::session::output;
 use crate::psx3xx::{Psx3xx, Psx3xxSuite};
@@ -62,20 +62,21 @@ pub(crate) struct PsxFuzz<'a, 's> {
 
 impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
     type Family = Psx3xx<'a, 's>;
+    type Step = PsxStep;
 
     fn generate(&mut self, rng: &mut Rng) -> Vec<Step> {
         self.gen.sequence(rng)
     }
 
-    fn own_kind(c: &CyclicStep) -> Option<String> {
-        own_kind(c)
+    fn kind(s: &PsxStep) -> String {
+        kind(s)
     }
 
     fn spec(&self) -> &Family {
         self.suite.family()
     }
 
-    fn case(&self, steps: &[Step]) -> (CaseInfo, PsxCase) {
+    fn case(&self, steps: &[Step], own: &[&PsxStep]) -> (CaseInfo, PsxCase) {
         let mut requirements: Vec<String> = steps
             .iter()
             .flat_map(|s| s.requirements.iter().cloned())
@@ -92,17 +93,23 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
         };
         // The motion cases' tolerance as soon as anything may move the drive; the ISDU
         // cases' (exact) otherwise.
-        let moves = steps.iter().any(|s| match &s.action {
-            Action::Cyclic(
-                CyclicStep::IsduRead { .. } | CyclicStep::Hold { .. } | CyclicStep::Advance { .. },
-            ) => false,
-            Action::Cyclic(CyclicStep::IsduWrite { index, .. }) => self.moving.contains(index),
+        let moves = own.iter().any(|a| match a {
+            PsxStep::IsduRead { .. } | PsxStep::Hold { .. } | PsxStep::Advance { .. } => false,
+            PsxStep::IsduWrite { index, .. } => self.moving.contains(index),
             _ => true,
         });
         let d = self.suite.reference().rules().default_format();
         let case = PsxCase {
             start: idle(self.suite, d),
-            steps: steps.iter().map(to_case_step).collect(),
+            steps: own
+                .iter()
+                .zip(steps)
+                .map(|(a, s)| StepDef {
+                    role: Role::Check,
+                    text: s.text.clone(),
+                    action: bounded(a),
+                })
+                .collect(),
             tol: if moves { MOTION } else { EXACT },
             plot: false,
         };
@@ -160,71 +167,32 @@ fn idle(suite: &Psx3xxSuite<'_>, format: u8) -> Output {
     output(format, 0, 0, 0, inactive.0)
 }
 
-/// The signature names of the PSx3xx steps ([`cyclic_target::kind`] names the shared ones).
-fn own_kind(c: &CyclicStep) -> Option<String> {
-    match c {
-        CyclicStep::ProcessData { format, .. } => Some(format!("pd-format-{format}")),
-        CyclicStep::IsduRead { index, .. } => Some(format!("isdu-read-{index}")),
-        CyclicStep::IsduWrite { index, .. } => Some(format!("isdu-write-{index}")),
-        _ => None,
+/// The signature name of a PSx3xx step: `pd-format-<format>`, `isdu-read-<index>`,
+/// `isdu-write-<index>`, `env-<kind>` or the step's name.
+fn kind(s: &PsxStep) -> String {
+    match s {
+        PsxStep::PdOut { format, .. } => format!("pd-format-{format}"),
+        PsxStep::IsduRead { index, .. } => format!("isdu-read-{index}"),
+        PsxStep::IsduWrite { index, .. } => format!("isdu-write-{index}"),
+        PsxStep::Env { env } => cyclic_target::env_signature(env),
+        other => other.name().to_owned(),
     }
 }
 
-/// A fuzz step as a conformance step (judged). Steps of other protocols never reach here
-/// (replay files are checked on load); they would cycle once with the outputs unchanged.
-fn to_case_step(s: &Step) -> StepDef {
-    let action = match &s.action {
-        Action::Cyclic(c) => match c {
-            CyclicStep::ProcessData {
-                format,
-                control,
-                target,
-                speed,
-                stamp,
-            } => PsxStep::PdOut {
-                format: *format,
-                control: *control,
-                target: *target,
-                speed: *speed,
-                stamp: *stamp,
-            },
-            CyclicStep::IsduRead { index, subindex } => PsxStep::IsduRead {
-                index: *index,
-                subindex: *subindex,
-            },
-            CyclicStep::IsduWrite {
-                index,
-                subindex,
-                data,
-            } => PsxStep::IsduWrite {
-                index: *index,
-                subindex: *subindex,
-                data: data.clone(),
-            },
-            CyclicStep::Hold { cycles } => PsxStep::Hold {
-                cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
-            },
-            CyclicStep::Until { running, max } => PsxStep::Until {
-                running: *running,
-                max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
-            },
-            CyclicStep::Env(env) => PsxStep::Env {
-                env: env.to_string(),
-            },
-            CyclicStep::Advance { us } => PsxStep::Advance {
-                us: (*us).min(cyclic_target::MAX_ADVANCE_US),
-            },
-            CyclicStep::Process { .. }
-            | CyclicStep::Offset { .. }
-            | CyclicStep::Pkw { .. }
-            | CyclicStep::RecordRead { .. }
-            | CyclicStep::RecordWrite { .. } => PsxStep::Hold { cycles: 1 },
+/// A step within the bounds a replay file cannot exceed (most cycles of a wait, longest
+/// `advance`).
+fn bounded(s: &PsxStep) -> PsxStep {
+    match s {
+        PsxStep::Hold { cycles } => PsxStep::Hold {
+            cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
         },
-        _ => PsxStep::Hold { cycles: 1 },
-    };
-    StepDef {
-        role: Role::Check,
-        text: s.text.clone(),
-        action,
+        PsxStep::Until { running, max } => PsxStep::Until {
+            running: *running,
+            max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
+        },
+        PsxStep::Advance { us } => PsxStep::Advance {
+            us: (*us).min(cyclic_target::MAX_ADVANCE_US),
+        },
+        other => other.clone(),
     }
 }

@@ -14,11 +14,12 @@
 use crate::cyclic::Env;
 use crate::fuzz::cyclic_target::env_kind;
 use crate::fuzz::engine::{self, below, chance, pick};
-use crate::fuzz::replay::{Action, CyclicStep, Step};
+use crate::fuzz::replay::{Action, Step};
 use crate::psd4xx::cases::{control, control_bit};
 use crate::psd4xx::Psd4xxSuite;
 use crate::rng::Rng;
 use drivespec_psd4xx::model::LinkEvent;
+use drivespec_psd4xx::step::{PkwBlock, Step as PsdStep};
 use drivespec_psd4xx::{PkwRequest, PkwRules, RecordRules, RecordWrite, Request, Width};
 use drivespec_spec::{Family, Parameter};
 
@@ -351,9 +352,9 @@ impl PsdGen {
         Template::Read
     }
 
-    fn push(&self, out: &mut Vec<Step>, t: Template, step: CyclicStep, text: String) {
+    fn push(&self, out: &mut Vec<Step>, t: Template, step: PsdStep, text: String) {
         out.push(Step {
-            action: Action::Cyclic(step),
+            action: Action::Psd4xx(step),
             class: class(t).to_owned(),
             text,
             requirements: reqs(t).iter().map(|s| (*s).to_owned()).collect(),
@@ -365,12 +366,14 @@ impl PsdGen {
         self.push(
             out,
             t,
-            CyclicStep::Pkw {
-                ak: p.ak.0,
-                spm: p.spm,
-                pnu: p.pnu,
-                ind: p.ind,
-                pwe: p.pwe,
+            PsdStep::Pkw {
+                pkw: PkwBlock {
+                    ak: p.ak.0,
+                    spm: p.spm,
+                    pnu: p.pnu,
+                    ind: p.ind,
+                    pwe: p.pwe,
+                },
             },
             text,
         );
@@ -399,7 +402,7 @@ impl PsdGen {
         self.push(
             out,
             t,
-            CyclicStep::Hold { cycles },
+            PsdStep::Hold { cycles },
             format!("{cycles} cycle(s)"),
         );
     }
@@ -412,7 +415,7 @@ impl PsdGen {
         self.push(
             out,
             t,
-            CyclicStep::Process {
+            PsdStep::Process {
                 control: Some(control),
                 target,
             },
@@ -424,7 +427,7 @@ impl PsdGen {
         self.push(
             out,
             t,
-            CyclicStep::Offset {
+            PsdStep::Offset {
                 control: Some(control),
                 offset,
             },
@@ -436,7 +439,7 @@ impl PsdGen {
         self.push(
             out,
             t,
-            CyclicStep::Until {
+            PsdStep::Until {
                 running,
                 max: WAIT_MAX,
             },
@@ -853,7 +856,7 @@ impl PsdGen {
                 self.push(
                     out,
                     t,
-                    CyclicStep::RecordRead { index },
+                    PsdStep::RecordRead { index },
                     format!("record read {index}"),
                 );
             }
@@ -888,7 +891,7 @@ impl PsdGen {
                         self.push(
                             out,
                             t,
-                            CyclicStep::RecordRead { index: p.pnu },
+                            PsdStep::RecordRead { index: p.pnu },
                             format!("record read {}", p.pnu),
                         );
                     }
@@ -928,8 +931,11 @@ impl PsdGen {
                     10 => Env::LoadTorque(u16::try_from(rng.range(0, 200)).unwrap_or(0)),
                     _ => Env::PowerCycle,
                 };
-                if !self.takes(&env_kind(&env)) {
-                    let Some(other) = ENV_KINDS.iter().find(|e| self.takes(&env_kind(e))).copied()
+                if !self.takes(&env_kind(&env.to_string())) {
+                    let Some(other) = ENV_KINDS
+                        .iter()
+                        .find(|e| self.takes(&env_kind(&e.to_string())))
+                        .copied()
                     else {
                         return;
                     };
@@ -939,7 +945,14 @@ impl PsdGen {
                     self.offset(out, t, c.run, Self::distance(rng));
                     self.until(out, t, true);
                 }
-                self.push(out, t, CyclicStep::Env(env), format!("env {env}"));
+                self.push(
+                    out,
+                    t,
+                    PsdStep::Env {
+                        env: env.to_string(),
+                    },
+                    format!("env {env}"),
+                );
                 self.hold(out, t, u32::try_from(rng.range(1, 30)).unwrap_or(1));
                 if chance(rng, 50) {
                     self.until(out, t, false);
@@ -950,7 +963,9 @@ impl PsdGen {
                     self.push(
                         out,
                         t,
-                        CyclicStep::Env(Env::Jam(true)),
+                        PsdStep::Env {
+                            env: Env::Jam(true).to_string(),
+                        },
                         "env jam 1".to_owned(),
                     );
                 }
@@ -960,7 +975,9 @@ impl PsdGen {
                 self.push(
                     out,
                     t,
-                    CyclicStep::Env(Env::Jam(true)),
+                    PsdStep::Env {
+                        env: Env::Jam(true).to_string(),
+                    },
                     "env jam 1".to_owned(),
                 );
                 self.until(out, t, false);
@@ -968,7 +985,9 @@ impl PsdGen {
                 self.push(
                     out,
                     t,
-                    CyclicStep::Env(Env::Jam(false)),
+                    PsdStep::Env {
+                        env: Env::Jam(false).to_string(),
+                    },
                     "env jam 0".to_owned(),
                 );
                 if chance(rng, 50) {
@@ -981,7 +1000,7 @@ impl PsdGen {
                 self.push(
                     out,
                     t,
-                    CyclicStep::Advance { us },
+                    PsdStep::Advance { us },
                     format!("{} ms without a bus cycle", us / 1000),
                 );
                 self.hold(out, t, u32::try_from(rng.range(1, 5)).unwrap_or(1));
@@ -991,6 +1010,6 @@ impl PsdGen {
 
     fn record_write(&self, out: &mut Vec<Step>, t: Template, index: u16, data: Vec<u8>) {
         let text = format!("record write {index}: {} byte(s)", data.len());
-        self.push(out, t, CyclicStep::RecordWrite { index, data }, text);
+        self.push(out, t, PsdStep::RecordWrite { index, hex: data }, text);
     }
 }

@@ -17,11 +17,12 @@
 
 use crate::cyclic::Env;
 use crate::fuzz::engine::{self, below, chance, pick};
-use crate::fuzz::replay::{Action, CyclicStep, Step};
+use crate::fuzz::replay::{Action, Step};
 use crate::psx3xx::Psx3xxSuite;
 use crate::rng::Rng;
 use drivespec_psd4xx::model::LinkEvent;
 use drivespec_psx3xx::isdu::{Target, Value};
+use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_psx3xx::{Guards, Rules};
 use drivespec_spec::psx3xx::{FormatEffect, StateCommand};
 use drivespec_spec::{Access, Family, Readings};
@@ -456,7 +457,7 @@ impl<'s> PsxGen<'s> {
         Template::Read
     }
 
-    fn push(&self, out: &mut Vec<Step>, t: Template, step: CyclicStep, text: String) {
+    fn push(&self, out: &mut Vec<Step>, t: Template, step: PsxStep, text: String) {
         self.push_with(out, t, step, text, &[]);
     }
 
@@ -464,7 +465,7 @@ impl<'s> PsxGen<'s> {
         &self,
         out: &mut Vec<Step>,
         t: Template,
-        step: CyclicStep,
+        step: PsxStep,
         text: String,
         extra: &[String],
     ) {
@@ -472,7 +473,7 @@ impl<'s> PsxGen<'s> {
         requirements.extend(extra.iter().cloned());
         requirements.dedup();
         out.push(Step {
-            action: Action::Cyclic(step),
+            action: Action::Psx3xx(step),
             class: class(t).to_owned(),
             text,
             requirements,
@@ -499,7 +500,7 @@ impl<'s> PsxGen<'s> {
         self.push(
             out,
             t,
-            CyclicStep::IsduRead {
+            PsxStep::IsduRead {
                 index: e.index,
                 subindex: e.subindex,
             },
@@ -516,7 +517,7 @@ impl<'s> PsxGen<'s> {
         self.push_with(
             out,
             t,
-            CyclicStep::IsduWrite {
+            PsxStep::IsduWrite {
                 index: e.index,
                 subindex: e.subindex,
                 data,
@@ -541,7 +542,7 @@ impl<'s> PsxGen<'s> {
         self.push(
             out,
             t,
-            CyclicStep::Hold { cycles },
+            PsxStep::Hold { cycles },
             format!("{cycles} cycle(s)"),
         );
     }
@@ -550,7 +551,7 @@ impl<'s> PsxGen<'s> {
         self.push(
             out,
             t,
-            CyclicStep::Until {
+            PsxStep::Until {
                 running,
                 max: WAIT_MAX,
             },
@@ -563,7 +564,14 @@ impl<'s> PsxGen<'s> {
     }
 
     fn env(&self, out: &mut Vec<Step>, t: Template, env: Env) {
-        self.push(out, t, CyclicStep::Env(env), format!("env {env}"));
+        self.push(
+            out,
+            t,
+            PsxStep::Env {
+                env: env.to_string(),
+            },
+            format!("env {env}"),
+        );
     }
 
     /// Process data in format 1 or 2 (`speed` only in format 2).
@@ -577,7 +585,7 @@ impl<'s> PsxGen<'s> {
         self.push(
             out,
             t,
-            CyclicStep::ProcessData {
+            PsxStep::PdOut {
                 format: f,
                 control,
                 target,
@@ -593,7 +601,7 @@ impl<'s> PsxGen<'s> {
         self.push(
             out,
             t,
-            CyclicStep::ProcessData {
+            PsxStep::PdOut {
                 format: 0,
                 control: u16::from(code),
                 target: 0,
@@ -767,7 +775,7 @@ impl<'s> PsxGen<'s> {
                 self.push(
                     out,
                     t,
-                    CyclicStep::IsduWrite {
+                    PsxStep::IsduWrite {
                         index: e.index,
                         subindex: e.subindex,
                         data,
@@ -798,7 +806,7 @@ impl<'s> PsxGen<'s> {
                     self.push(
                         out,
                         t,
-                        CyclicStep::IsduRead { index, subindex },
+                        PsxStep::IsduRead { index, subindex },
                         format!("ISDU read {index}.{subindex} (not in the table)"),
                     );
                 } else {
@@ -807,7 +815,7 @@ impl<'s> PsxGen<'s> {
                     self.push(
                         out,
                         t,
-                        CyclicStep::IsduWrite {
+                        PsxStep::IsduWrite {
                             index,
                             subindex,
                             data,
@@ -839,7 +847,7 @@ impl<'s> PsxGen<'s> {
                     self.push(
                         out,
                         t,
-                        CyclicStep::IsduRead { index, subindex },
+                        PsxStep::IsduRead { index, subindex },
                         format!("ISDU read {index}.{subindex} (no such sub-index)"),
                     );
                 } else {
@@ -848,7 +856,7 @@ impl<'s> PsxGen<'s> {
                     self.push(
                         out,
                         t,
-                        CyclicStep::IsduWrite {
+                        PsxStep::IsduWrite {
                             index,
                             subindex,
                             data,
@@ -878,7 +886,7 @@ impl<'s> PsxGen<'s> {
                 self.push(
                     out,
                     t,
-                    CyclicStep::IsduWrite {
+                    PsxStep::IsduWrite {
                         index: e.index,
                         subindex: e.subindex,
                         data,
@@ -914,7 +922,7 @@ impl<'s> PsxGen<'s> {
                     self.push_with(
                         out,
                         t,
-                        CyclicStep::IsduWrite {
+                        PsxStep::IsduWrite {
                             index: guard.index,
                             subindex: guard.subindex,
                             data,
@@ -947,7 +955,7 @@ impl<'s> PsxGen<'s> {
                     self.push_with(
                         out,
                         t,
-                        CyclicStep::IsduWrite {
+                        PsxStep::IsduWrite {
                             index: guarded.index,
                             subindex: guarded.subindex,
                             data,
@@ -1035,7 +1043,7 @@ impl<'s> PsxGen<'s> {
                 self.push(
                     out,
                     t,
-                    CyclicStep::IsduRead {
+                    PsxStep::IsduRead {
                         index: self.entry(DELIVERY_STATE).map_or(193, |e| e.index),
                         subindex: 0,
                     },
@@ -1050,7 +1058,7 @@ impl<'s> PsxGen<'s> {
                 self.push(
                     out,
                     t,
-                    CyclicStep::IsduRead {
+                    PsxStep::IsduRead {
                         index: self.entry(DELIVERY_STATE).map_or(193, |e| e.index),
                         subindex: 0,
                     },
@@ -1115,7 +1123,7 @@ impl<'s> PsxGen<'s> {
                         self.push(
                             out,
                             t,
-                            CyclicStep::IsduRead {
+                            PsxStep::IsduRead {
                                 index: dp.isdu_index,
                                 subindex: sub,
                             },
@@ -1395,7 +1403,7 @@ impl<'s> PsxGen<'s> {
                 self.push(
                     out,
                     t,
-                    CyclicStep::Advance { us },
+                    PsxStep::Advance { us },
                     format!("{} ms without a bus cycle", us / 1000),
                 );
                 self.hold(out, t, u32::try_from(rng.range(1, 5)).unwrap_or(1));
