@@ -151,9 +151,20 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
             for k in &r.stale_expectations {
                 println!("stale expectation: {} matches no selected case", k.case);
             }
+            let mut seen: Vec<(String, usize)> = Vec::new();
+            for f in r.cases.iter().flat_map(|c| &c.findings) {
+                let line = f.line();
+                match seen.iter_mut().find(|(l, _)| *l == line) {
+                    Some((_, n)) => *n += 1,
+                    None => seen.push((line, 1)),
+                }
+            }
+            for (line, n) in &seen {
+                println!("acceptable: {line} ({n} case(s))");
+            }
             println!(
-                "{} passed, {} failed, {} skipped ({} expected failures, {} fixed, {} not run) of {} cases against {}",
-                s.passed, s.failed, s.skipped, s.expected_failures, s.fixed, s.not_run, s.total, r.run.transport
+                "{} passed ({} acceptable), {} failed, {} skipped ({} expected failures, {} fixed, {} not run) of {} cases against {}",
+                s.passed, s.acceptable, s.failed, s.skipped, s.expected_failures, s.fixed, s.not_run, s.total, r.run.transport
             );
             for w in &summary.written {
                 println!("report: {}", w.display());

@@ -154,11 +154,50 @@ pub struct Record {
     pub note: Option<String>,
 }
 
+/// A point where the manual allows several outcomes, and the one the device showed.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Finding {
+    /// The device follows one reading of an erratum (`spec errata`).
+    Reading {
+        /// The erratum (`HPD-ERRATUM-058`).
+        erratum: String,
+        /// The reading's id in the spec.
+        reading: String,
+        /// What the reading says.
+        text: String,
+    },
+    /// The manual leaves the point open (an example value, a silent point, a bound).
+    Open {
+        /// The requirement the point belongs to.
+        requirement: String,
+        /// What the device did, one line.
+        text: String,
+    },
+}
+
+impl Finding {
+    /// One line: `follows reading R of E: text` or `ID: text`.
+    pub fn line(&self) -> String {
+        match self {
+            Finding::Reading {
+                erratum,
+                reading,
+                text,
+            } => format!("follows reading `{reading}` of {erratum}: {text}"),
+            Finding::Open { requirement, text } => format!("{requirement}: {text}"),
+        }
+    }
+}
+
 /// What a session reports for one case.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CaseRun {
     /// Pass, fail or skip.
     pub outcome: Outcome,
+    /// Points where the device showed one of several outcomes the manual allows; a passing
+    /// case with findings is `acceptable`.
+    pub findings: Vec<Finding>,
     /// One record per step run.
     pub evidence: Vec<Record>,
     /// Time that passed on the transport's clock (µs; virtual for `sim`).

@@ -1024,6 +1024,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         };
         if let Err(e) = reset_ok {
             return CaseRun {
+                findings: Vec::new(),
                 outcome: Outcome::Fail(Failure {
                     step: None,
                     message: format!("the device could not be reset: {e}"),
@@ -1072,6 +1073,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             });
         }
         CaseRun {
+            findings: Vec::new(),
             outcome: match run.failure {
                 Some(f) => Outcome::Fail(f),
                 None => Outcome::Pass,
@@ -1090,6 +1092,7 @@ impl<'s, F: CyclicFamily<'s>> Session for CyclicSession<'_, F> {
     fn run(&mut self, index: usize) -> CaseRun {
         let Some((info, case)) = self.family.case(index) else {
             return CaseRun {
+                findings: Vec::new(),
                 outcome: Outcome::Skip {
                     reason: format!("no case {index}"),
                 },

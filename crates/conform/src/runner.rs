@@ -235,7 +235,8 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         let run = session.run(*ci);
         let wall_ms = started.elapsed().as_secs_f64() * 1000.0;
         let status = match (&run.outcome, known) {
-            (Outcome::Pass, None) => Status::Pass,
+            (Outcome::Pass, None) if run.findings.is_empty() => Status::Pass,
+            (Outcome::Pass, None) => Status::Acceptable,
             (Outcome::Pass, Some(_)) => Status::Fixed,
             (Outcome::Fail(_), None) => Status::Fail,
             (Outcome::Fail(_), Some(_)) => Status::ExpectedFailure,
@@ -333,16 +334,16 @@ fn case_report(
     replay: Option<String>,
     wall_ms: f64,
 ) -> CaseReport {
-    let (failure, skip_reason, evidence, elapsed_us) = match run {
+    let (failure, skip_reason, evidence, elapsed_us, findings) = match run {
         Some(r) => {
             let (failure, skip) = match r.outcome {
                 Outcome::Pass => (None, None),
                 Outcome::Fail(f) => (Some(f), None),
                 Outcome::Skip { reason } => (None, Some(reason)),
             };
-            (failure, skip, r.evidence, r.elapsed_us)
+            (failure, skip, r.evidence, r.elapsed_us, r.findings)
         }
-        None => (None, None, Vec::new(), 0),
+        None => (None, None, Vec::new(), 0, Vec::new()),
     };
     let expectation = match status {
         Status::ExpectedFailure | Status::Fixed | Status::NotRun => expectation,
@@ -357,6 +358,7 @@ fn case_report(
         status,
         failure,
         skip_reason,
+        findings,
         expectation,
         evidence,
         replay,
@@ -403,6 +405,10 @@ fn build_report(
     for c in &cases {
         match c.status {
             Status::Pass => counts.passed += 1,
+            Status::Acceptable => {
+                counts.passed += 1;
+                counts.acceptable += 1;
+            }
             Status::Fail => counts.failed += 1,
             Status::ExpectedFailure => counts.expected_failures += 1,
             Status::Fixed => counts.fixed += 1,

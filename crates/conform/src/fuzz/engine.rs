@@ -459,6 +459,7 @@ impl OtherFamilyStep {
     /// The run of a sequence that holds this step: failed before anything was sent.
     pub(crate) fn failed_run(&self) -> CaseRun {
         CaseRun {
+            findings: Vec::new(),
             outcome: Outcome::Fail(Failure {
                 step: Some(self.index),
                 message: self.to_string(),

@@ -355,6 +355,7 @@ impl Session for HpdSession<'_, '_> {
         let suite = self.suite;
         let (Some(info), Some(case)) = (suite.infos.get(index), suite.cases.get(index)) else {
             return CaseRun {
+                findings: Vec::new(),
                 outcome: Outcome::Skip {
                     reason: format!("no case {index}"),
                 },
@@ -429,6 +430,7 @@ impl HpdSession<'_, '_> {
         let caps = self.link.caps();
         if case.needs_power_cycle && !caps.power_cycle {
             return CaseRun {
+                findings: Vec::new(),
                 outcome: Outcome::Skip {
                     reason: "needs the device switched off and on, which this transport cannot do (only sim can)".to_owned(),
                 },
@@ -443,6 +445,7 @@ impl HpdSession<'_, '_> {
                 Ok(false) => {}
                 Err(e) => {
                     return CaseRun {
+                        findings: Vec::new(),
                         outcome: Outcome::Fail(Failure {
                             step: None,
                             message: format!("transport: {e}"),
@@ -683,6 +686,7 @@ impl HpdSession<'_, '_> {
         }
         let elapsed_us = self.link.now().saturating_sub(start);
         CaseRun {
+            findings: Vec::new(),
             outcome: match failure {
                 Some(f) => Outcome::Fail(f),
                 None => Outcome::Pass,

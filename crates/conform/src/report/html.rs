@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;margin:2em;color:#222}\
 h1{font-size:1.5em}h2{font-size:1.2em;margin-top:2em}\
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:.2em .5em;vertical-align:top;text-align:left}\
-.pass{color:#176f2c}.fail{color:#b00020;font-weight:bold}.expected-failure{color:#a15c00}.fixed{color:#0057b3}\
+.pass{color:#176f2c}.acceptable{color:#2d6a8f}.fail{color:#b00020;font-weight:bold}.expected-failure{color:#a15c00}.fixed{color:#0057b3}\
 .skipped,.not-run,.untested{color:#777}code,pre{font:12px ui-monospace,monospace}pre{white-space:pre-wrap;margin:0}\
 details{margin:.3em 0;border-left:3px solid #ddd;padding-left:.6em}summary{cursor:pointer}\
 .bad{background:#fde8ea}.muted{color:#777}";
@@ -57,8 +57,8 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
     );
     let _ = writeln!(
         h,
-        "<table><tr><th>cases</th><th class=\"pass\">pass</th><th class=\"fail\">fail</th><th class=\"expected-failure\">expected failures</th><th class=\"fixed\">fixed</th><th class=\"skipped\">skipped</th><th class=\"not-run\">not run</th></tr><tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr></table>",
-        s.total, s.passed, s.failed, s.expected_failures, s.fixed, s.skipped, s.not_run
+        "<table><tr><th>cases</th><th class=\"pass\">pass</th><th class=\"acceptable\">of which acceptable</th><th class=\"fail\">fail</th><th class=\"expected-failure\">expected failures</th><th class=\"fixed\">fixed</th><th class=\"skipped\">skipped</th><th class=\"not-run\">not run</th></tr><tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr></table>",
+        s.total, s.passed, s.acceptable, s.failed, s.expected_failures, s.fixed, s.skipped, s.not_run
     );
     for k in &r.stale_expectations {
         let _ = writeln!(
@@ -161,6 +161,13 @@ fn case(h: &mut String, c: &CaseReport) {
                 escape(&r.text)
             );
         }
+    }
+    for f in &c.findings {
+        let _ = writeln!(
+            h,
+            "<p class=\"acceptable\">acceptable: {}</p>",
+            escape(&f.line())
+        );
     }
     if let Some(e) = &c.expectation {
         let _ = writeln!(

@@ -56,6 +56,12 @@ fn case(c: &CaseReport) -> Case {
     };
     let outcome = match c.status {
         Status::Pass => Outcome::Passed,
+        Status::Acceptable => Outcome::PassedWithOutput(
+            c.findings
+                .iter()
+                .map(|f| format!("acceptable: {}\n", f.line()))
+                .collect(),
+        ),
         Status::Fixed => Outcome::PassedWithOutput(format!(
             "passes although the expectations file lists it as a known failure ({}); remove the entry",
             c.expectation.as_deref().unwrap_or("")

@@ -8,7 +8,7 @@ mod junit;
 pub use html::{html, html_with};
 pub use junit::{junit, junit_with};
 
-use crate::case::{Failure, Record};
+use crate::case::{Failure, Finding, Record};
 use drivespec_spec::{FamilyId, Level};
 use serde::Serialize;
 
@@ -21,6 +21,8 @@ pub const SCHEMA: &str = "drivespec-conform/1";
 pub enum Status {
     /// Passed.
     Pass,
+    /// Passed, showing one of several outcomes the manual allows (its findings say which).
+    Acceptable,
     /// Failed and not expected to: fails the run.
     Fail,
     /// Failed as the expectations file says.
@@ -38,6 +40,7 @@ impl Status {
     pub fn as_str(self) -> &'static str {
         match self {
             Status::Pass => "pass",
+            Status::Acceptable => "acceptable",
             Status::Fail => "fail",
             Status::ExpectedFailure => "expected-failure",
             Status::Fixed => "fixed",
@@ -107,6 +110,8 @@ pub struct Counts {
     pub total: usize,
     /// Passed.
     pub passed: usize,
+    /// Passed with an outcome the manual allows among several (also counted in `passed`).
+    pub acceptable: usize,
     /// Failed unexpectedly.
     pub failed: usize,
     /// Failed as expected.
@@ -142,6 +147,9 @@ pub struct CaseReport {
     /// Why it was skipped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub skip_reason: Option<String>,
+    /// Which of several allowed outcomes the device showed (acceptable).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub findings: Vec<Finding>,
     /// The expectations entry's reason (expected-failure and fixed).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub expectation: Option<String>,
