@@ -166,6 +166,12 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
                 "{} passed ({} acceptable), {} failed, {} skipped ({} expected failures, {} fixed, {} not run) of {} cases against {}",
                 s.passed, s.acceptable, s.failed, s.skipped, s.expected_failures, s.fixed, s.not_run, s.total, r.run.transport
             );
+            for c in &r.coverage_summary {
+                println!(
+                    "coverage {}: {} of {} must requirements checked",
+                    c.family, c.checked, c.must
+                );
+            }
             for w in &summary.written {
                 println!("report: {}", w.display());
             }

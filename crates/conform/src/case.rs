@@ -198,6 +198,9 @@ pub struct CaseRun {
     /// Points where the device showed one of several outcomes the manual allows; a passing
     /// case with findings is `acceptable`.
     pub findings: Vec<Finding>,
+    /// The requirements whose checks evaluated in this case (the judged steps' own
+    /// requirements), for coverage by checking rather than by citation.
+    pub checked: Vec<String>,
     /// One record per step run.
     pub evidence: Vec<Record>,
     /// Time that passed on the transport's clock (µs; virtual for `sim`).

@@ -940,6 +940,34 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         bad_steps
     }
 
+    /// The requirements a judged run checked: the case's, and in a motion case the rules of
+    /// every status bit whose changes were compared (it changed on the reference).
+    fn checked(&self, run: &Run<'_, 's, F::Input, F::Output>) -> Vec<String> {
+        if !run.evidence.iter().any(|r| r.ok.is_some()) {
+            return Vec::new();
+        }
+        let mut ids = run.reqs.to_vec();
+        if run.tol.motion {
+            let words: Vec<u16> = run
+                .cycles
+                .iter()
+                .map(|c| F::motion(&c.reference).2)
+                .collect();
+            let changed = words.windows(2).fold(0u16, |acc, w| match w {
+                [a, b] => acc | (a ^ b),
+                _ => acc,
+            });
+            for bit in (0..16u16).filter(|b| changed & (1 << b) != 0) {
+                for id in self.bit_rules(bit, None) {
+                    if !ids.contains(&id) {
+                        ids.push(id);
+                    }
+                }
+            }
+        }
+        ids
+    }
+
     /// The requirements of status bit `bit`'s rules (spec bitfield `status`): those that make
     /// it `to` first (set rules for `Some(true)`, reset rules for `Some(false)`).
     fn bit_rules(&self, bit: u16, to: Option<bool>) -> Vec<String> {
@@ -1025,6 +1053,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         if let Err(e) = reset_ok {
             return CaseRun {
                 findings: Vec::new(),
+                checked: Vec::new(),
                 outcome: Outcome::Fail(Failure {
                     step: None,
                     message: format!("the device could not be reset: {e}"),
@@ -1074,6 +1103,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         }
         CaseRun {
             findings: Vec::new(),
+            checked: self.checked(&run),
             outcome: match run.failure {
                 Some(f) => Outcome::Fail(f),
                 None => Outcome::Pass,
@@ -1093,6 +1123,7 @@ impl<'s, F: CyclicFamily<'s>> Session for CyclicSession<'_, F> {
         let Some((info, case)) = self.family.case(index) else {
             return CaseRun {
                 findings: Vec::new(),
+                checked: Vec::new(),
                 outcome: Outcome::Skip {
                     reason: format!("no case {index}"),
                 },

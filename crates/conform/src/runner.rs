@@ -11,11 +11,12 @@
 use crate::case::{CaseInfo, CaseRun, Outcome};
 use crate::dut::{shell_quote, Dut};
 use crate::report::{
-    self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, Report, RunInfo, Status, Tool,
+    self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, FamilyCoverage, Report, RunInfo,
+    Status, Tool,
 };
 use crate::select::{Expectations, LevelFilter, SelectError, Selection};
 use crate::suite::{self, Session, Settings, SetupError, Suite};
-use drivespec_spec::{FamilyId, Level, Spec};
+use drivespec_spec::{FamilyId, Level, Requirement, Spec};
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -334,16 +335,23 @@ fn case_report(
     replay: Option<String>,
     wall_ms: f64,
 ) -> CaseReport {
-    let (failure, skip_reason, evidence, elapsed_us, findings) = match run {
+    let (failure, skip_reason, evidence, elapsed_us, findings, checked) = match run {
         Some(r) => {
             let (failure, skip) = match r.outcome {
                 Outcome::Pass => (None, None),
                 Outcome::Fail(f) => (Some(f), None),
                 Outcome::Skip { reason } => (None, Some(reason)),
             };
-            (failure, skip, r.evidence, r.elapsed_us, r.findings)
+            (
+                failure,
+                skip,
+                r.evidence,
+                r.elapsed_us,
+                r.findings,
+                r.checked,
+            )
         }
-        None => (None, None, Vec::new(), 0, Vec::new()),
+        None => (None, None, Vec::new(), 0, Vec::new(), Vec::new()),
     };
     let expectation = match status {
         Status::ExpectedFailure | Status::Fixed | Status::NotRun => expectation,
@@ -358,6 +366,7 @@ fn case_report(
         status,
         failure,
         skip_reason,
+        checked,
         findings,
         expectation,
         evidence,
@@ -419,49 +428,28 @@ fn build_report(
     counts.exit_code = u8::from(counts.failed > 0);
     let families: Vec<FamilyId> = suites.iter().map(|s| s.family()).collect();
     let mut coverage = Vec::new();
+    let mut coverage_summary = Vec::new();
     for s in suites {
         let family = spec.family(s.family());
+        let mut must = FamilyCoverage {
+            family: s.family(),
+            must: 0,
+            checked: 0,
+        };
         for req in &family.requirements {
-            let refs: Vec<CaseRef> = s
-                .cases()
-                .iter()
-                .filter(|c| c.requirements.contains(&req.id))
-                .map(|c| CaseRef {
-                    id: c.id.clone(),
-                    status: cases
-                        .iter()
-                        .find(|r| r.id == c.id)
-                        .map_or(Status::NotRun, |r| r.status),
-                })
-                .collect();
-            if req.level == Level::Informative && refs.is_empty() {
+            let row = coverage_row(req, s.cases(), &cases);
+            if req.level == Level::Must {
+                must.must += 1;
+                if matches!(row.verdict, Coverage::Pass | Coverage::Fail) {
+                    must.checked += 1;
+                }
+            }
+            if req.level == Level::Informative && row.cases.is_empty() {
                 continue;
             }
-            let ran: Vec<Status> = refs
-                .iter()
-                .map(|r| r.status)
-                .filter(|s| !matches!(s, Status::Skipped | Status::NotRun))
-                .collect();
-            let verdict = if refs.is_empty() {
-                Coverage::Untested
-            } else if ran.is_empty() {
-                Coverage::NotRun
-            } else if ran
-                .iter()
-                .any(|s| matches!(s, Status::Fail | Status::ExpectedFailure))
-            {
-                Coverage::Fail
-            } else {
-                Coverage::Pass
-            };
-            coverage.push(CoverageRow {
-                requirement: req.id.clone(),
-                level: req.level,
-                text: req.text.clone(),
-                verdict,
-                cases: refs,
-            });
+            coverage.push(row);
         }
+        coverage_summary.push(must);
     }
     let ids: Vec<&str> = suites
         .iter()
@@ -494,7 +482,65 @@ fn build_report(
         summary: counts,
         cases,
         coverage,
+        coverage_summary,
         stale_expectations: stale,
+    }
+}
+
+/// The coverage row of `req`: the run cases whose checks evaluated it (Fail when a failure
+/// names it), or else the cases that cite it.
+fn coverage_row(req: &Requirement, suite: &[CaseInfo], results: &[CaseReport]) -> CoverageRow {
+    let checking: Vec<&CaseReport> = results
+        .iter()
+        .filter(|r| r.checked.contains(&req.id))
+        .collect();
+    let (verdict, refs) = if checking.is_empty() {
+        let refs: Vec<CaseRef> = suite
+            .iter()
+            .filter(|c| c.requirements.contains(&req.id))
+            .map(|c| CaseRef {
+                id: c.id.clone(),
+                status: results
+                    .iter()
+                    .find(|r| r.id == c.id)
+                    .map_or(Status::NotRun, |r| r.status),
+            })
+            .collect();
+        let ran = refs
+            .iter()
+            .any(|r| !matches!(r.status, Status::Skipped | Status::NotRun));
+        let verdict = if refs.is_empty() || ran {
+            Coverage::Untested
+        } else {
+            Coverage::NotRun
+        };
+        (verdict, refs)
+    } else {
+        let names = |r: &CaseReport| {
+            r.failure
+                .as_ref()
+                .is_some_and(|f| f.requirements.iter().any(|x| x.id == req.id))
+        };
+        let verdict = if checking.iter().any(|r| names(r)) {
+            Coverage::Fail
+        } else {
+            Coverage::Pass
+        };
+        let refs = checking
+            .iter()
+            .map(|r| CaseRef {
+                id: r.id.clone(),
+                status: r.status,
+            })
+            .collect();
+        (verdict, refs)
+    };
+    CoverageRow {
+        requirement: req.id.clone(),
+        level: req.level,
+        text: req.text.clone(),
+        verdict,
+        cases: refs,
     }
 }
 

@@ -460,6 +460,7 @@ impl OtherFamilyStep {
     pub(crate) fn failed_run(&self) -> CaseRun {
         CaseRun {
             findings: Vec::new(),
+            checked: Vec::new(),
             outcome: Outcome::Fail(Failure {
                 step: Some(self.index),
                 message: self.to_string(),

@@ -8,7 +8,8 @@ use super::replay::Replay;
 use super::stats::Stats;
 use crate::case::{CaseRun, Failure, RequirementRef};
 use crate::report::{
-    self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, Report, RunInfo, Status, Tool,
+    self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, FamilyCoverage, Report, RunInfo,
+    Status, Tool,
 };
 use drivespec_spec::{FamilyId, Level};
 use serde::Serialize;
@@ -123,6 +124,12 @@ pub(crate) fn build(
             status: Status::Fail,
             failure: Some(f.failure.clone()),
             skip_reason: None,
+            checked: f
+                .failure
+                .requirements
+                .first()
+                .map(|r| vec![r.id.clone()])
+                .unwrap_or_default(),
             findings: Vec::new(),
             expectation: None,
             evidence: f.run.evidence.clone(),
@@ -145,6 +152,7 @@ pub(crate) fn build(
             status: Status::Pass,
             failure: None,
             skip_reason: None,
+            checked: touched.clone(),
             findings: Vec::new(),
             expectation: None,
             evidence: Vec::new(),
@@ -180,6 +188,15 @@ pub(crate) fn build(
         });
     }
     let failed = findings.len();
+    let must: Vec<&CoverageRow> = coverage.iter().filter(|r| r.level == Level::Must).collect();
+    let coverage_summary = vec![FamilyCoverage {
+        family: desc.family,
+        must: must.len(),
+        checked: must
+            .iter()
+            .filter(|r| matches!(r.verdict, Coverage::Pass | Coverage::Fail))
+            .count(),
+    }];
     Report {
         schema: report::SCHEMA,
         tool: Tool {
@@ -207,6 +224,7 @@ pub(crate) fn build(
         },
         cases,
         coverage,
+        coverage_summary,
         stale_expectations: Vec::new(),
     }
 }

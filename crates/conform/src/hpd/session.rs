@@ -286,6 +286,23 @@ impl<'a, 's> HpdSession<'a, 's> {
         out.into_iter().map(str::to_owned).collect()
     }
 
+    /// The requirements a judged step checks: its own, the case's for a check step (the
+    /// behaviour under test), and those the reference's answer `expected` shows.
+    fn step_checks(&self, case_reqs: &[String], step: &Step, expected: &[u8]) -> Vec<String> {
+        let mut ids = step.requirements.clone();
+        let case = if step.role == Role::Check {
+            case_reqs
+        } else {
+            &[]
+        };
+        for r in case.iter().cloned().chain(self.answer_reqs(expected)) {
+            if !ids.contains(&r) {
+                ids.push(r);
+            }
+        }
+        ids
+    }
+
     fn requirement_refs(
         &self,
         case_reqs: &[String],
@@ -356,6 +373,7 @@ impl Session for HpdSession<'_, '_> {
         let (Some(info), Some(case)) = (suite.infos.get(index), suite.cases.get(index)) else {
             return CaseRun {
                 findings: Vec::new(),
+                checked: Vec::new(),
                 outcome: Outcome::Skip {
                     reason: format!("no case {index}"),
                 },
@@ -431,6 +449,7 @@ impl HpdSession<'_, '_> {
         if case.needs_power_cycle && !caps.power_cycle {
             return CaseRun {
                 findings: Vec::new(),
+                checked: Vec::new(),
                 outcome: Outcome::Skip {
                     reason: "needs the device switched off and on, which this transport cannot do (only sim can)".to_owned(),
                 },
@@ -446,6 +465,7 @@ impl HpdSession<'_, '_> {
                 Err(e) => {
                     return CaseRun {
                         findings: Vec::new(),
+                        checked: Vec::new(),
                         outcome: Outcome::Fail(Failure {
                             step: None,
                             message: format!("transport: {e}"),
@@ -461,6 +481,7 @@ impl HpdSession<'_, '_> {
         }
         let mut evidence: Vec<Record> = Vec::new();
         let mut failure: Option<Failure> = None;
+        let mut checked: Vec<String> = Vec::new();
         let mut broken = false;
         let mut last_request: Option<Message> = None;
         for (i, step) in case.steps.iter().enumerate() {
@@ -625,12 +646,17 @@ impl HpdSession<'_, '_> {
                 Ok(Some((ok, why))) => {
                     if judged {
                         rec.ok = Some(ok);
+                        let exp_bytes = rec
+                            .expected
+                            .as_ref()
+                            .and_then(|a| drivespec_spec::hex::parse_hex(&a.hex).ok())
+                            .unwrap_or_default();
+                        for id in self.step_checks(&info.requirements, step, &exp_bytes) {
+                            if !checked.contains(&id) {
+                                checked.push(id);
+                            }
+                        }
                         if !ok {
-                            let exp_bytes = rec
-                                .expected
-                                .as_ref()
-                                .and_then(|a| drivespec_spec::hex::parse_hex(&a.hex).ok())
-                                .unwrap_or_default();
                             failure = Some(Failure {
                                 step: Some(evidence.len()),
                                 message: format!("step {i} ({}): {why}", step.text),
@@ -687,6 +713,7 @@ impl HpdSession<'_, '_> {
         let elapsed_us = self.link.now().saturating_sub(start);
         CaseRun {
             findings: Vec::new(),
+            checked,
             outcome: match failure {
                 Some(f) => Outcome::Fail(f),
                 None => Outcome::Pass,

@@ -69,6 +69,15 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
         );
     }
 
+    for c in &r.coverage_summary {
+        let _ = writeln!(
+            h,
+            "<p>coverage {}: {} of {} <code>must</code> requirements checked</p>",
+            escape(&c.family.to_string()),
+            c.checked,
+            c.must
+        );
+    }
     h.push_str(extra);
     h.push_str("<h2>Requirement coverage</h2>\n<table><tr><th>requirement</th><th>level</th><th>verdict</th><th>cases</th><th>text</th></tr>\n");
     for row in &r.coverage {

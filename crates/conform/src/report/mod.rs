@@ -65,6 +65,8 @@ pub struct Report {
     pub cases: Vec<CaseReport>,
     /// Requirement → cases → verdict.
     pub coverage: Vec<CoverageRow>,
+    /// Per family: how many `must` requirements a check evaluated.
+    pub coverage_summary: Vec<FamilyCoverage>,
     /// Expectations entries that matched no selected case.
     pub stale_expectations: Vec<crate::select::KnownFailure>,
 }
@@ -147,6 +149,8 @@ pub struct CaseReport {
     /// Why it was skipped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub skip_reason: Option<String>,
+    /// The requirements whose checks evaluated in this case.
+    pub checked: Vec<String>,
     /// Which of several allowed outcomes the device showed (acceptable).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub findings: Vec<Finding>,
@@ -164,18 +168,29 @@ pub struct CaseReport {
     pub elapsed_us: u64,
 }
 
-/// Verdict of a requirement over its cases.
+/// Verdict of a requirement over the checks that evaluated it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Coverage {
-    /// Every case run passed.
+    /// Checked, and no failure names it.
     Pass,
-    /// A case failed (expected or not).
+    /// A failure (expected or not) names it.
     Fail,
-    /// Cases exist but none ran (skipped, not selected, not run).
+    /// Cases cite it but none ran (skipped, not selected, not run).
     NotRun,
-    /// No case covers it.
+    /// No check evaluated it (cases may cite it).
     Untested,
+}
+
+/// How many of a family's `must` requirements a check evaluated in the run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct FamilyCoverage {
+    /// The family.
+    pub family: FamilyId,
+    /// Its `must` requirements.
+    pub must: usize,
+    /// Those a check evaluated.
+    pub checked: usize,
 }
 
 /// One row of the coverage matrix.
