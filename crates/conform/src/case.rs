@@ -33,6 +33,8 @@ pub struct RequirementRef {
     pub level: Level,
     /// The requirement in the spec's words.
     pub text: String,
+    /// The manual section it comes from.
+    pub source: String,
 }
 
 impl RequirementRef {
@@ -42,7 +44,13 @@ impl RequirementRef {
             id: r.id.clone(),
             level: r.level,
             text: r.text.clone(),
+            source: r.source.clone(),
         })
+    }
+
+    /// `ID (section): text`, the way a failure names the requirement it broke.
+    pub fn line(&self) -> String {
+        format!("{} ({}): {}", self.id, self.source, self.text)
     }
 }
 
@@ -57,8 +65,29 @@ pub struct Failure {
     pub expected: String,
     /// What the device under test did.
     pub got: String,
-    /// The requirements the failing step and the case cover, with their text.
+    /// The requirements the failing step and the case cover, with their text; the first is
+    /// the one the device broke.
     pub requirements: Vec<RequirementRef>,
+}
+
+impl Failure {
+    /// The requirement the device broke (the first one named).
+    pub fn broken(&self) -> Option<&RequirementRef> {
+        self.requirements.first()
+    }
+
+    /// The lines people read first: the broken requirement, what went wrong, what the manual
+    /// allows and what came.
+    pub fn headline(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(r) = self.broken() {
+            lines.push(format!("breaks {}", r.line()));
+        }
+        lines.push(self.message.clone());
+        lines.push(format!("allowed: {}", self.expected));
+        lines.push(format!("got:     {}", self.got));
+        lines
+    }
 }
 
 /// What running a case found, before expectations are applied.

@@ -247,13 +247,17 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             .outcome
             .failed()
             .then(|| replay_line(opts, &settings, &info.id));
+        let headline = match &run.outcome {
+            Outcome::Fail(f) if status == Status::Fail => f.headline(),
+            _ => Vec::new(),
+        };
         show(
             progress,
             mode,
-            n + 1,
-            total,
+            (n + 1, total),
             &info.id,
             status,
+            &headline,
             replay.as_deref(),
         );
         if status == Status::Fail && opts.fail_fast {
@@ -292,30 +296,38 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     })
 }
 
+/// One case's progress; a failure shows its headline (the broken requirement first) and the
+/// replay command.
 fn show(
     out: &mut dyn Write,
     mode: Progress,
-    n: usize,
-    total: usize,
+    (n, total): (usize, usize),
     id: &str,
     status: Status,
+    headline: &[String],
     replay: Option<&str>,
 ) {
+    let details = |out: &mut dyn Write| {
+        for l in headline {
+            let _ = writeln!(out, "  {l}");
+        }
+        if let Some(r) = replay {
+            let _ = writeln!(out, "  replay: {r}");
+        }
+    };
     match mode {
         Progress::Quiet | Progress::Auto => {}
         Progress::Plain => {
             let _ = writeln!(out, "{:<16} {id} ({n}/{total})", status.as_str());
-            if let (Status::Fail, Some(r)) = (status, replay) {
-                let _ = writeln!(out, "  replay: {r}");
+            if status == Status::Fail {
+                details(out);
             }
         }
         Progress::Bar => {
             if status == Status::Fail {
                 let _ = write!(out, "\r\x1b[2K");
                 let _ = writeln!(out, "fail {id}");
-                if let Some(r) = replay {
-                    let _ = writeln!(out, "  replay: {r}");
-                }
+                details(out);
             }
             let width = 30;
             let done = n * width / total.max(1);

@@ -72,3 +72,25 @@ fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
     assert_eq!(caught, all.len());
 }
+
+/// What a CI log shows first for a failure: the broken requirement, then what went wrong,
+/// what the manual allows and what came.
+#[test]
+fn a_failure_names_the_broken_requirement_first() {
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let m = mutants()
+        .into_iter()
+        .find(|m| m.name == "checksum off by one")
+        .unwrap();
+    let link = SimLink::new(format!("mutant: {}", m.name), Box::new(Mutant::new(m.kind)));
+    let mut session = suite.session(Box::new(link));
+    let i = suite
+        .cases()
+        .iter()
+        .position(|c| c.id == "hpd/frame/read-parameter")
+        .unwrap();
+    let Outcome::Fail(f) = session.run(i).outcome else {
+        panic!("the mutant passes hpd/frame/read-parameter");
+    };
+    insta::assert_snapshot!(f.headline().join("\n"));
+}

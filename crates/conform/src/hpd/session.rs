@@ -303,14 +303,26 @@ impl<'a, 's> HpdSession<'a, 's> {
         ids
     }
 
+    /// The requirements a failing step cites, the broken one first: the frame rule the
+    /// device's answer `got` breaks when it is not a message, then the step's own, those the
+    /// reference's answer `expected` shows, and the case's.
     fn requirement_refs(
         &self,
         case_reqs: &[String],
         step: Option<&Step>,
         expected: &[u8],
+        got: &[u8],
     ) -> Vec<RequirementRef> {
         let family = self.suite.family();
-        let mut ids: Vec<String> = step.map(|s| s.requirements.clone()).unwrap_or_default();
+        let mut ids: Vec<String> = frame_rule_broken(&self.suite.rules, got)
+            .map(str::to_owned)
+            .into_iter()
+            .collect();
+        for r in step.map(|s| s.requirements.clone()).unwrap_or_default() {
+            if !ids.contains(&r) {
+                ids.push(r);
+            }
+        }
         for r in self
             .answer_reqs(expected)
             .into_iter()
@@ -323,6 +335,17 @@ impl<'a, 's> HpdSession<'a, 's> {
         ids.into_iter()
             .filter_map(|id| RequirementRef::of(family, &id))
             .collect()
+    }
+}
+
+/// The frame rule (manual 4.1) bytes `got` break when they start a message that does not
+/// decode: its checksum or its stuffing.
+fn frame_rule_broken(rules: &drivespec_hpd::FrameRules, got: &[u8]) -> Option<&'static str> {
+    let from = got.iter().position(|b| *b == rules.stx)?;
+    match drivespec_hpd::parse(rules, got.get(from..)?) {
+        Err(drivespec_hpd::FrameError::Checksum { .. }) => Some("HPD-FRAME-009"),
+        Err(drivespec_hpd::FrameError::Stuffing { .. }) => Some("HPD-FRAME-003"),
+        _ => None,
     }
 }
 
@@ -666,6 +689,9 @@ impl HpdSession<'_, '_> {
                                     &info.requirements,
                                     Some(step),
                                     &exp_bytes,
+                                    &rec.got.as_ref().map_or_else(Vec::new, |a| {
+                                        drivespec_spec::hex::parse_hex(&a.hex).unwrap_or_default()
+                                    }),
                                 ),
                             });
                         }
@@ -692,6 +718,7 @@ impl HpdSession<'_, '_> {
                                 &info.requirements,
                                 Some(step),
                                 &concat(&expected),
+                                &[],
                             ),
                         });
                     }

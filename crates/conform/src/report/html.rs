@@ -154,9 +154,18 @@ fn case(h: &mut String, c: &CaseReport) {
         escape(&c.description)
     );
     if let Some(f) = &c.failure {
+        if let Some(r) = f.broken() {
+            let _ = writeln!(
+                h,
+                "<p class=\"fail\">breaks <code>{}</code> ({}): {}</p>",
+                escape(&r.id),
+                escape(&r.source),
+                escape(&r.text)
+            );
+        }
         let _ = writeln!(
             h,
-            "<p class=\"fail\">{}</p><table><tr><th>expected</th><td><code>{}</code></td></tr><tr><th>got</th><td><code>{}</code></td></tr></table>",
+            "<p class=\"fail\">{}</p><table><tr><th>allowed</th><td><code>{}</code></td></tr><tr><th>got</th><td><code>{}</code></td></tr></table>",
             escape(&f.message),
             escape(&f.expected),
             escape(&f.got)

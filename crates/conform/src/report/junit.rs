@@ -74,7 +74,13 @@ fn case(c: &CaseReport) -> Case {
         Status::Skipped => Outcome::Skipped(c.skip_reason.clone().unwrap_or_default()),
         Status::Fail => {
             let (message, text) = match &c.failure {
-                Some(f) => (f.message.clone(), failure_text(c)),
+                Some(f) => (
+                    match f.broken() {
+                        Some(r) => format!("breaks {}: {}", r.id, f.message),
+                        None => f.message.clone(),
+                    },
+                    failure_text(c),
+                ),
                 None => ("failed".to_owned(), String::new()),
             };
             Outcome::Failed {
@@ -96,12 +102,12 @@ fn case(c: &CaseReport) -> Case {
 pub(crate) fn failure_text(c: &CaseReport) -> String {
     let mut t = String::new();
     if let Some(f) = &c.failure {
-        let _ = writeln!(t, "{}", f.message);
-        let _ = writeln!(t, "expected: {}", f.expected);
-        let _ = writeln!(t, "got:      {}", f.got);
-        if !f.requirements.is_empty() {
-            t.push_str("requirements:\n");
-            for r in &f.requirements {
+        for l in f.headline() {
+            let _ = writeln!(t, "{l}");
+        }
+        if f.requirements.len() > 1 {
+            t.push_str("also cited:\n");
+            for r in f.requirements.iter().skip(1) {
                 let _ = writeln!(t, "  {} ({}): {}", r.id, r.level.as_str(), r.text);
             }
         }
