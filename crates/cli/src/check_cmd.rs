@@ -255,7 +255,7 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
         ReportArg::Junit => render::junit(&reports),
         ReportArg::Html => render::html(&reports),
     };
-    print!("{out}");
+    say_raw!("{out}")?;
     if let Some(dir) = &args.report_dir {
         write_reports(dir, &reports)?;
     }

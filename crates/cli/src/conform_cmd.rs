@@ -121,12 +121,12 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
     let summary = drivespec_conform::run(&spec, &opts, &mut err)?;
     if opts.list {
         match ctx.format {
-            Format::Json => println!("{}", json(&serde_json::json!({ "cases": summary.listed }))),
+            Format::Json => say!("{}", json(&serde_json::json!({ "cases": summary.listed })))?,
             Format::Text => {
                 for c in &summary.listed {
-                    println!("{:<48} {:<6} {}", c.id, c.level.as_str(), c.description);
+                    say!("{:<48} {:<6} {}", c.id, c.level.as_str(), c.description)?;
                 }
-                println!("{} case(s)", summary.listed.len());
+                say!("{} case(s)", summary.listed.len())?;
             }
         }
         return Ok(Outcome::Pass);
@@ -134,22 +134,22 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
     let r = &summary.report;
     let s = r.summary;
     match ctx.format {
-        Format::Json => println!(
+        Format::Json => say!(
             "{}",
             json(&serde_json::json!({
                 "summary": s,
                 "reports": summary.written,
             }))
-        ),
+        )?,
         Format::Text => {
             for c in r.cases.iter().filter(|c| c.status == Status::Fixed) {
-                println!(
+                say!(
                     "fixed: {} passes; remove it from the expectations file",
                     c.id
-                );
+                )?;
             }
             for k in &r.stale_expectations {
-                println!("stale expectation: {} matches no selected case", k.case);
+                say!("stale expectation: {} matches no selected case", k.case)?;
             }
             let mut seen: Vec<(String, usize)> = Vec::new();
             for f in r.cases.iter().flat_map(|c| &c.findings) {
@@ -160,20 +160,22 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
                 }
             }
             for (line, n) in &seen {
-                println!("acceptable: {line} ({n} case(s))");
+                say!("acceptable: {line} ({n} case(s))")?;
             }
-            println!(
+            say!(
                 "{} passed ({} acceptable), {} failed, {} skipped ({} expected failures, {} fixed, {} not run) of {} cases against {}",
                 s.passed, s.acceptable, s.failed, s.skipped, s.expected_failures, s.fixed, s.not_run, s.total, r.run.transport
-            );
+            )?;
             for c in &r.coverage_summary {
-                println!(
+                say!(
                     "coverage {}: {} of {} must requirements checked",
-                    c.family, c.checked, c.must
-                );
+                    c.family,
+                    c.checked,
+                    c.must
+                )?;
             }
             for w in &summary.written {
-                println!("report: {}", w.display());
+                say!("report: {}", w.display())?;
             }
         }
     }

@@ -108,7 +108,7 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
     if let Some(file) = &args.replay {
         let r = Replay::load(file)?;
         let out = fuzz::replay(&spec, &opts, &r)?;
-        print_replay(ctx, file, &out);
+        print_replay(ctx, file, &out)?;
         return Ok(if out.exit_code() == 0 {
             Outcome::Pass
         } else {
@@ -123,7 +123,7 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
     let summary = fuzz::run(&spec, &opts, &mut err)?;
     let s = &summary.stats;
     match ctx.format {
-        Format::Json => println!(
+        Format::Json => say!(
             "{}",
             json(&serde_json::json!({
                 "summary": summary.report.summary,
@@ -132,9 +132,9 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
                 "findings": s.findings,
                 "reports": summary.written,
             }))
-        ),
+        )?,
         Format::Text => {
-            println!(
+            say!(
                 "{} sequence(s), {} input(s), {} finding(s) against {} (seed {}, stopped by {})",
                 s.sequences,
                 s.inputs,
@@ -142,9 +142,9 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
                 summary.report.run.transport,
                 s.seed,
                 s.stopped_by
-            );
+            )?;
             for f in &s.findings {
-                println!(
+                say!(
                     "{}: {} in {} step(s), seen {} time(s){}",
                     f.id,
                     f.signature,
@@ -154,10 +154,10 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
                         .as_ref()
                         .map(|p| format!("; replay: {p}"))
                         .unwrap_or_default()
-                );
+                )?;
             }
             for w in &summary.written {
-                println!("report: {}", w.display());
+                say!("report: {}", w.display())?;
             }
         }
     }
@@ -177,12 +177,12 @@ fn minimize(
 ) -> Result<Outcome> {
     let Some(min) = fuzz::minimize(spec, opts, r)? else {
         match ctx.format {
-            Format::Json => println!("{}", json(&serde_json::json!({ "fails": false }))),
-            Format::Text => println!(
+            Format::Json => say!("{}", json(&serde_json::json!({ "fails": false })))?,
+            Format::Text => say!(
                 "{}: passes against {}: nothing to minimise",
                 file.display(),
                 opts.dut
-            ),
+            )?,
         }
         return Ok(Outcome::Pass);
     };
@@ -199,7 +199,7 @@ fn minimize(
         .map(|f| f.signature.clone())
         .unwrap_or_default();
     match ctx.format {
-        Format::Json => println!(
+        Format::Json => say!(
             "{}",
             json(&serde_json::json!({
                 "fails": true,
@@ -208,24 +208,24 @@ fn minimize(
                 "from": r.steps.len(),
                 "file": path,
             }))
-        ),
-        Format::Text => println!(
+        )?,
+        Format::Text => say!(
             "{sig}: {} step(s) (from {}) written to {}",
             min.steps.len(),
             r.steps.len(),
             path.display()
-        ),
+        )?,
     }
     Ok(Outcome::Fail)
 }
 
-fn print_replay(ctx: &Context, file: &Path, out: &ReplayOutcome) {
+fn print_replay(ctx: &Context, file: &Path, out: &ReplayOutcome) -> Result<()> {
     let verdict = match &out.fault {
         Some((class, sig, step)) => format!("fails at step {step}: {sig} ({})", class.as_str()),
         None => "passes".to_owned(),
     };
     match ctx.format {
-        Format::Json => println!(
+        Format::Json => say!(
             "{}",
             json(&serde_json::json!({
                 "file": file,
@@ -235,7 +235,7 @@ fn print_replay(ctx: &Context, file: &Path, out: &ReplayOutcome) {
                 "same_finding": out.same_finding,
                 "exchanges": out.exchanges,
             }))
-        ),
+        )?,
         Format::Text => {
             let hex = |h: &Option<String>| match h.as_deref() {
                 Some("") => "silence".to_owned(),
@@ -248,32 +248,33 @@ fn print_replay(ctx: &Context, file: &Path, out: &ReplayOutcome) {
                     Some(false) => "BAD",
                     None => "   ",
                 };
-                println!(
+                say!(
                     "{mark} #{:<3} +{:>8} µs  sent {}",
                     e.step,
                     e.at_us,
                     e.sent.as_deref().unwrap_or("-")
-                );
+                )?;
                 if e.expected.is_some() || e.got.is_some() {
-                    println!(
+                    say!(
                         "               reference {}\n               device    {}",
                         hex(&e.expected),
                         hex(&e.got)
-                    );
+                    )?;
                 }
                 if let Some(n) = &e.note {
-                    println!("               note      {n}");
+                    say!("               note      {n}")?;
                 }
             }
-            println!("{}: {verdict}", file.display());
-            println!(
+            say!("{}: {verdict}", file.display())?;
+            say!(
                 "{}",
                 if out.same_as_recorded {
                     "the exchange is byte for byte the recorded one"
                 } else {
                     "the exchange differs from the recorded one"
                 }
-            );
+            )?;
         }
     }
+    Ok(())
 }

@@ -121,8 +121,8 @@ pub fn decode(args: DecodeArgs, ctx: &Context) -> Result<Outcome> {
     }
     pairer.flush(&mut |x| out.exchanges.push(exchange_out(&x)));
     match ctx.format {
-        Format::Json => println!("{}", json(&out)),
-        Format::Text => print!("{}", decoded_text(&out, args.stream.is_some())),
+        Format::Json => say!("{}", json(&out))?,
+        Format::Text => say_raw!("{}", decoded_text(&out, args.stream.is_some()))?,
     }
     Ok(if out.discarded.is_empty() {
         Outcome::Pass
@@ -326,7 +326,7 @@ pub fn encode(args: EncodeArgs, ctx: &Context) -> Result<Outcome> {
     let msg = build(&spec, family, args.what)?;
     let bytes = msg.to_bytes(&rules)?;
     match ctx.format {
-        Format::Text => println!("{}", to_hex(&bytes)),
+        Format::Text => say!("{}", to_hex(&bytes))?,
         Format::Json => {
             #[derive(Serialize)]
             struct Out {
@@ -340,13 +340,13 @@ pub fn encode(args: EncodeArgs, ctx: &Context) -> Result<Outcome> {
                 &msg,
                 None,
             );
-            println!(
+            say!(
                 "{}",
                 json(&Out {
                     bytes: to_hex(&bytes),
                     message
                 })
-            );
+            )?;
         }
     }
     Ok(Outcome::Pass)
@@ -495,18 +495,20 @@ pub fn plc(args: PlcArgs, ctx: &Context) -> Result<Outcome> {
             .and_then(|(_, c)| c.clone());
     }
     match ctx.format {
-        Format::Json => println!("{}", json(&out)),
+        Format::Json => say!("{}", json(&out))?,
         Format::Text => {
             for i in &out.instructions {
                 match &i.comment {
-                    Some(c) => println!(
+                    Some(c) => say!(
                         "{:02X}: {:<14} ; {:<11} ; {c}",
-                        i.address, i.listing, i.bytes
-                    ),
-                    None => println!("{:02X}: {:<14} ; {}", i.address, i.listing, i.bytes),
+                        i.address,
+                        i.listing,
+                        i.bytes
+                    )?,
+                    None => say!("{:02X}: {:<14} ; {}", i.address, i.listing, i.bytes)?,
                 }
             }
-            println!("{} bytes: {}", bytes.len(), out.bytes);
+            say!("{} bytes: {}", bytes.len(), out.bytes)?;
             let names = |list: &[Named]| -> String {
                 list.iter()
                     .map(|n| match &n.name {
@@ -516,10 +518,10 @@ pub fn plc(args: PlcArgs, ctx: &Context) -> Result<Outcome> {
                     .collect::<Vec<_>>()
                     .join(", ")
             };
-            println!("reads:  {}", names(&out.reads));
-            println!("drives: {}", names(&out.writes));
+            say!("reads:  {}", names(&out.reads))?;
+            say!("drives: {}", names(&out.writes))?;
             for issue in &out.issues {
-                println!("warning: {issue}");
+                say!("warning: {issue}")?;
             }
         }
     }

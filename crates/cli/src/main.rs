@@ -1,5 +1,24 @@
 //! `drivespec`: the command-line front end. Parsing and printing only; the work is in the libraries.
 
+/// `println!` that returns the write error instead of panicking ([`StdoutClosed`]).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).map_err($crate::StdoutClosed)
+    }};
+}
+
+/// `print!` that returns the write error instead of panicking ([`StdoutClosed`]).
+macro_rules! say_raw {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut out = std::io::stdout().lock();
+        write!(out, $($arg)*)
+            .and_then(|()| out.flush())
+            .map_err($crate::StdoutClosed)
+    }};
+}
+
 mod check_cmd;
 mod conform_cmd;
 mod fuzz_cmd;
@@ -134,6 +153,12 @@ impl Context {
 
 pub use drivespec_report::json;
 
+/// Standard output could not be written: a reader that went away (a broken pipe ends the
+/// command quietly with exit 0) or a write error (exit 2).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write to standard output: {0}")]
+pub struct StdoutClosed(std::io::Error);
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -175,9 +200,14 @@ fn main() -> ExitCode {
     match result {
         Ok(Outcome::Pass) => ExitCode::SUCCESS,
         Ok(Outcome::Fail) => ExitCode::from(1),
-        Err(e) => {
-            eprintln!("drivespec: {e:#}");
-            ExitCode::from(2)
-        }
+        Err(e) => match e.downcast_ref::<StdoutClosed>() {
+            Some(StdoutClosed(io)) if io.kind() == std::io::ErrorKind::BrokenPipe => {
+                ExitCode::SUCCESS
+            }
+            _ => {
+                eprintln!("drivespec: {e:#}");
+                ExitCode::from(2)
+            }
+        },
     }
 }

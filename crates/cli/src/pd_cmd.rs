@@ -96,7 +96,7 @@ pub fn decode_psd4xx(args: Psd4xxDecode, ctx: &Context) -> Result<Outcome> {
     let spec = ctx.spec()?;
     let rules = psd_rules(&spec, args.byte_order)?;
     let e = drivespec_psd4xx::explain(&rules, psd_direction(&args.dir), &bytes)?;
-    Ok(report(ctx, &e, e.notes.is_empty()))
+    report(ctx, &e, e.notes.is_empty())
 }
 
 /// Runs `drivespec encode psd4xx`.
@@ -142,20 +142,20 @@ fn print_image<E: serde::Serialize>(
     explain: impl FnOnce() -> Result<E>,
 ) -> Result<Outcome> {
     match ctx.format {
-        Format::Text => println!("{}", to_hex(bytes)),
+        Format::Text => say!("{}", to_hex(bytes))?,
         Format::Json => {
             #[derive(serde::Serialize)]
             struct Out<E> {
                 bytes: String,
                 image: E,
             }
-            println!(
+            say!(
                 "{}",
                 json(&Out {
                     bytes: to_hex(bytes),
                     image: explain()?
                 })
-            );
+            )?;
         }
     }
     Ok(Outcome::Pass)
@@ -229,8 +229,8 @@ pub fn decode_psx3xx(args: Psx3xxDecode, ctx: &Context) -> Result<Outcome> {
         }
         let d = drivespec_psx3xx::detect_order(&rules, &images);
         match ctx.format {
-            Format::Json => println!("{}", json(&d)),
-            Format::Text => println!("{d}"),
+            Format::Json => say!("{}", json(&d))?,
+            Format::Text => say!("{d}")?,
         }
         return Ok(Outcome::Pass);
     }
@@ -241,7 +241,7 @@ pub fn decode_psx3xx(args: Psx3xxDecode, ctx: &Context) -> Result<Outcome> {
     } else {
         drivespec_psx3xx::explain_input(&rules, order, model, &bytes)?
     };
-    Ok(report(ctx, &e, e.warnings.is_empty()))
+    report(ctx, &e, e.warnings.is_empty())
 }
 
 /// Runs `drivespec encode psx3xx`.
@@ -279,14 +279,14 @@ pub fn encode_psx3xx(args: Psx3xxEncode, ctx: &Context) -> Result<Outcome> {
 }
 
 /// Prints an explanation (text ending in one newline, or JSON); fails when it is not `clean`.
-fn report<E: std::fmt::Display + serde::Serialize>(ctx: &Context, e: &E, clean: bool) -> Outcome {
+fn report<E: std::fmt::Display + serde::Serialize>(
+    ctx: &Context,
+    e: &E,
+    clean: bool,
+) -> Result<Outcome> {
     match ctx.format {
-        Format::Json => println!("{}", json(e)),
-        Format::Text => println!("{}", e.to_string().trim_end()),
+        Format::Json => say!("{}", json(e))?,
+        Format::Text => say!("{}", e.to_string().trim_end())?,
     }
-    if clean {
-        Outcome::Pass
-    } else {
-        Outcome::Fail
-    }
+    Ok(if clean { Outcome::Pass } else { Outcome::Fail })
 }

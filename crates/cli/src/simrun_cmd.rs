@@ -73,25 +73,28 @@ pub fn run(args: SimRunArgs, ctx: &Context) -> Result<Outcome> {
                 drivespec_psx3xx::model::DriveConfig::new(&args.model).with_readings(readings);
             let trace = drivespec_psx3xx::script::run_text(&spec, config, &text, &opts)
                 .with_context(|| format!("script {}", args.script.display()))?;
-            return Ok(print(ctx, &trace));
+            return print(ctx, &trace);
         }
         _ => bail!(
             "sim-run {:?}: not available; families with a script runner: psd4xx, psx3xx",
             args.device
         ),
     };
-    Ok(print(ctx, &trace))
+    print(ctx, &trace)
 }
 
 /// Prints a trace; fails when an expectation failed.
-fn print<E: std::fmt::Display + serde::Serialize>(ctx: &Context, trace: &Trace<E>) -> Outcome {
+fn print<E: std::fmt::Display + serde::Serialize>(
+    ctx: &Context,
+    trace: &Trace<E>,
+) -> Result<Outcome> {
     match ctx.format {
-        Format::Text => print!("{}", trace.to_text()),
-        Format::Json => println!("{}", json(trace)),
+        Format::Text => say_raw!("{}", trace.to_text())?,
+        Format::Json => say!("{}", json(trace))?,
     }
-    if trace.failed == 0 {
+    Ok(if trace.failed == 0 {
         Outcome::Pass
     } else {
         Outcome::Fail
-    }
+    })
 }

@@ -74,7 +74,7 @@ pub fn run(args: SpecArgs, ctx: &Context) -> Result<Outcome> {
             Some(dir) => Spec::load_dir(dir),
             None => Spec::builtin(),
         };
-        return Ok(check(loaded, format));
+        return check(loaded, format);
     }
     let spec = ctx.spec()?;
     let out = match &args.command {
@@ -107,7 +107,7 @@ pub fn run(args: SpecArgs, ctx: &Context) -> Result<Outcome> {
         SpecCommand::Errata { device } => errata(family(&spec, device)?, format),
         SpecCommand::Check => unreachable_check(),
     }?;
-    print!("{out}");
+    say_raw!("{out}")?;
     Ok(Outcome::Pass)
 }
 
@@ -115,7 +115,7 @@ fn unreachable_check() -> Result<String> {
     bail!("spec check is handled before loading")
 }
 
-fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Outcome {
+fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Result<Outcome> {
     #[derive(Serialize)]
     struct Report {
         ok: bool,
@@ -165,18 +165,18 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
                     }))
                     .collect(),
             };
-            println!("{}", json(&report));
+            say!("{}", json(&report))?;
         }
         Format::Text => {
             for p in &problems {
-                println!("{p}");
+                say!("{p}")?;
             }
             for p in &built {
-                println!("{p}");
+                say!("{p}")?;
             }
             if let (Ok(spec), true) = (&loaded, ok) {
                 for f in spec.families() {
-                    println!(
+                    say!(
                         "{}: {} parameters, {} models, {} bitfields, {} requirements, {} errata, {} vectors",
                         f.id(),
                         f.parameters.len(),
@@ -185,17 +185,13 @@ fn check(loaded: Result<Spec, drivespec_spec::SpecErrors>, format: Format) -> Ou
                         f.requirements.len(),
                         f.errata.len(),
                         f.vectors.len()
-                    );
+                    )?;
                 }
-                println!("spec ok");
+                say!("spec ok")?;
             }
         }
     }
-    if ok {
-        Outcome::Pass
-    } else {
-        Outcome::Fail
-    }
+    Ok(if ok { Outcome::Pass } else { Outcome::Fail })
 }
 
 fn family<'s>(spec: &'s Spec, device: &str) -> Result<&'s Family> {

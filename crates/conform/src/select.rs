@@ -4,6 +4,7 @@
 //! `hpd/*` work as expected. A pattern without `*`, `?` or `[` matches the ID itself and
 //! everything under it (`hpd/frame` selects `hpd/frame/...`).
 
+use drivespec_spec::bounded::read_text_bounded;
 use drivespec_spec::Level;
 use globset::{Glob, GlobMatcher};
 use serde::Deserialize;
@@ -31,6 +32,27 @@ pub enum SelectError {
     },
 }
 
+/// Longest case pattern: case IDs are well under 100 characters, and a glob's matcher grows
+/// with its length.
+const MAX_PATTERN: usize = 200;
+/// Largest expectations file read (bytes).
+const MAX_EXPECT_FILE: u64 = 1 << 20;
+/// Longest reason of a known failure (it is copied into the reports of every case it matches).
+const MAX_REASON: usize = 1000;
+
+/// At most 60 characters of `text`, to quote it in an error.
+fn clip(text: &str) -> String {
+    let n = text.chars().count();
+    if n <= 60 {
+        text.to_owned()
+    } else {
+        format!(
+            "{}… ({n} characters)",
+            text.chars().take(60).collect::<String>()
+        )
+    }
+}
+
 /// One case pattern.
 #[derive(Debug, Clone)]
 pub struct Pattern {
@@ -42,6 +64,12 @@ impl Pattern {
     /// Parses a pattern.
     pub fn new(text: &str) -> Result<Pattern, SelectError> {
         let text = text.trim().trim_end_matches('/').to_owned();
+        if text.chars().count() > MAX_PATTERN {
+            return Err(SelectError::Pattern {
+                pattern: clip(&text),
+                why: format!("longer than {MAX_PATTERN} characters"),
+            });
+        }
         let glob = if text.contains(['*', '?', '[', '{']) {
             Some(
                 Glob::new(&text)
@@ -178,7 +206,7 @@ impl Expectations {
     /// Reads and checks a file.
     pub fn load(path: &Path) -> Result<Expectations, SelectError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SelectError::Expect {
+        let text = read_text_bounded(path, MAX_EXPECT_FILE).map_err(|e| SelectError::Expect {
             file: file.clone(),
             why: e.to_string(),
         })?;
@@ -198,7 +226,14 @@ impl Expectations {
                 return Err(bad(format!(
                     "failure {} ({}): the reason is empty",
                     i + 1,
-                    f.case
+                    clip(&f.case)
+                )));
+            }
+            if f.reason.chars().count() > MAX_REASON {
+                return Err(bad(format!(
+                    "failure {} ({}): the reason is longer than {MAX_REASON} characters",
+                    i + 1,
+                    clip(&f.case)
                 )));
             }
             let p = Pattern::new(&f.case).map_err(|e| bad(format!("failure {}: {e}", i + 1)))?;

@@ -73,10 +73,8 @@ pub enum ProblemKind {
         message: String,
     },
     /// The file is larger than the loader accepts.
-    #[error("file is {size} bytes, more than the limit of {limit}")]
+    #[error("file is larger than the limit of {limit} bytes")]
     TooLarge {
-        /// Size of the file.
-        size: u64,
         /// The limit.
         limit: u64,
     },

@@ -1,5 +1,6 @@
 //! The set of files a spec is loaded from: embedded at build time or read from a folder.
 
+use crate::bounded::{read_text_bounded, ReadError};
 use crate::error::{Problem, ProblemKind, SpecErrors};
 use std::path::Path;
 
@@ -126,22 +127,14 @@ fn walk(root: &Path, dir: &Path, depth: usize, out: &mut SpecFiles, problems: &m
             ));
             return;
         }
-        let size = entry.metadata().map(|m| m.len()).unwrap_or(0);
-        if size > MAX_FILE {
-            problems.push(Problem::file(
-                shown,
-                ProblemKind::TooLarge {
-                    size,
-                    limit: MAX_FILE,
-                },
-            ));
-            continue;
-        }
-        match std::fs::read_to_string(&path) {
+        match read_text_bounded(&path, MAX_FILE) {
             Ok(text) => {
                 let rel = path.strip_prefix(root).unwrap_or(&path);
                 out.files
                     .push((rel.to_string_lossy().replace('\\', "/"), text));
+            }
+            Err(ReadError::TooLarge { limit, .. }) => {
+                problems.push(Problem::file(shown, ProblemKind::TooLarge { limit }))
             }
             Err(e) => problems.push(Problem::file(
                 shown,

@@ -6,6 +6,7 @@
 //! input; memory grows with the size of the files read.
 
 mod bitfield;
+pub mod bounded;
 mod device_model;
 mod erratum;
 mod error;

@@ -1,0 +1,165 @@
+//! Hostile inputs on the real binary: closed or full standard output, huge patterns,
+//! oversized expectations, spec files that are devices or FIFOs. Each ends with its exit code
+//! and one clear line, never a panic or a hang.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use drivespec_testkit::{run, temp_dir};
+use std::io::Read;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
+
+/// Runs `args` with stdout read for `keep` bytes and then closed; the exit code and stderr.
+fn run_closing_stdout(args: &[&str], keep: usize) -> (i32, String) {
+    let mut child = Command::new(BIN)
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = child.stdout.take().unwrap();
+    let mut buf = vec![0u8; keep];
+    out.read_exact(&mut buf).unwrap();
+    drop(out);
+    let result = child.wait_with_output().unwrap();
+    (
+        result.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&result.stderr).into_owned(),
+    )
+}
+
+/// Runs `args` with stdout on `/dev/full`; the exit code and stderr.
+fn run_into_full_disk(args: &[&str]) -> (i32, String) {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let result = Command::new(BIN)
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(full)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    (
+        result.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&result.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_reader_that_goes_away_ends_the_command_quietly() {
+    // Each prints more than a pipe holds, so it writes after the reader has gone.
+    for args in [
+        &["conform", "all", "--list"][..],
+        &["--format", "json", "spec", "requirements", "psd4xx"][..],
+    ] {
+        let (code, stderr) = run_closing_stdout(args, 1);
+        assert_eq!(code, 0, "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_is_one_error_line_and_exit_2() {
+    for args in [
+        &["decode", "hpd", "7E", "80", "01", "54", "D5"][..],
+        &["conform", "hpd", "--list"][..],
+        &["spec", "check"][..],
+    ] {
+        let (code, stderr) = run_into_full_disk(args);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert_eq!(
+            stderr,
+            "drivespec: cannot write to standard output: No space left on device (os error 28)\n",
+            "{args:?}"
+        );
+    }
+}
+
+#[test]
+fn a_huge_case_pattern_is_bad_usage_quoting_its_start() {
+    let stars = "*".repeat(100_000);
+    for flag in ["--case", "--skip"] {
+        let (code, _, stderr) = run(BIN, &["conform", "hpd", "--list", flag, &stars]);
+        assert_eq!(code, 2, "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("(100000 characters)"), "{stderr}");
+        assert!(stderr.len() < 200, "{stderr}");
+    }
+}
+
+#[test]
+fn an_oversized_expectations_reason_is_refused() {
+    let dir = temp_dir("hostile", "expect");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("expect.toml");
+    let reason = "x".repeat(1_000_000);
+    std::fs::write(
+        &file,
+        format!("[[failure]]\ncase = \"hpd/frame/*\"\nreason = \"{reason}\"\n"),
+    )
+    .unwrap();
+    let (code, _, stderr) = run(
+        BIN,
+        &[
+            "conform",
+            "hpd",
+            "--list",
+            "--expect",
+            file.to_str().unwrap(),
+        ],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("longer than 1000 characters"), "{stderr}");
+}
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            copy_tree(&p, &to.join(e.file_name()));
+        } else {
+            std::fs::copy(&p, to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+/// A copy of the workspace's spec with `name` in the HPD folder made by `make`.
+fn spec_with(name: &str, make: impl Fn(&Path)) -> std::path::PathBuf {
+    let dir = temp_dir("hostile", name);
+    copy_tree(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../spec"),
+        &dir,
+    );
+    make(&dir.join("hpd").join(name));
+    dir
+}
+
+#[cfg(unix)]
+#[test]
+fn spec_files_that_never_end_are_refused() {
+    let zero = spec_with("zero.toml", |p| {
+        std::os::unix::fs::symlink("/dev/zero", p).unwrap()
+    });
+    let fifo = spec_with("fifo.toml", |p| {
+        assert!(Command::new("mkfifo").arg(p).status().unwrap().success())
+    });
+    for dir in [zero, fifo] {
+        let (code, stdout, stderr) = run(BIN, &["--spec", dir.to_str().unwrap(), "spec", "check"]);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(code, 1, "{stdout}{stderr}");
+        assert!(stdout.contains("not a regular file"), "{stdout}");
+    }
+}
