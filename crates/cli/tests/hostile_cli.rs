@@ -163,3 +163,56 @@ fn spec_files_that_never_end_are_refused() {
         assert!(stdout.contains("not a regular file"), "{stdout}");
     }
 }
+
+#[test]
+fn a_bad_value_says_what_is_wrong_in_one_line() {
+    for (args, want) in [
+        (
+            &["encode", "hpd", "bit", "--addr", "0", "b99.14=2"][..],
+            "drivespec: value \"2\": a bit is 0 or 1\n",
+        ),
+        (
+            &["encode", "hpd", "write", "--addr", "0", "Pr33=1e308"][..],
+            "drivespec: value \"1e308\": too large for any parameter\n",
+        ),
+    ] {
+        let (code, _, stderr) = run(BIN, args);
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+        assert_eq!(stderr, want, "{args:?}");
+    }
+}
+
+#[test]
+fn a_huge_token_is_quoted_by_its_start_only() {
+    let dir = temp_dir("hostile", "token");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("program.txt");
+    std::fs::write(&file, "A".repeat(1_000_000)).unwrap();
+    let (code, _, stderr) = run(BIN, &["plc", "hpd", "asm", file.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("(1000000 characters)"), "{stderr}");
+    assert!(stderr.len() < 200, "{stderr}");
+}
+
+#[test]
+fn spec_scales_that_are_not_finite_or_zero_are_refused() {
+    for bad in ["nan", "inf", "0.0"] {
+        let dir = spec_with(&format!("scale-{bad}"), |_| {});
+        let file = dir.join("hpd/parameters.toml");
+        let text = std::fs::read_to_string(&file).unwrap();
+        std::fs::write(
+            &file,
+            text.replacen("scale = 0.1", &format!("scale = {bad}"), 1),
+        )
+        .unwrap();
+        let (code, stdout, stderr) = run(BIN, &["--spec", dir.to_str().unwrap(), "spec", "check"]);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(code, 1, "{bad}: {stdout}{stderr}");
+        assert!(
+            stdout.contains("is not a finite number other than 0"),
+            "{bad}: {stdout}"
+        );
+    }
+}

@@ -5,6 +5,7 @@
 //! everything under it (`hpd/frame` selects `hpd/frame/...`).
 
 use drivespec_spec::bounded::read_text_bounded;
+use drivespec_spec::quote::quote;
 use drivespec_spec::Level;
 use globset::{Glob, GlobMatcher};
 use serde::Deserialize;
@@ -15,7 +16,7 @@ use std::path::Path;
 #[non_exhaustive]
 pub enum SelectError {
     /// A pattern is not a glob.
-    #[error("bad case pattern {pattern:?}: {why}")]
+    #[error("bad case pattern {}: {why}", quote(.pattern))]
     Pattern {
         /// The pattern.
         pattern: String,
@@ -40,19 +41,6 @@ const MAX_EXPECT_FILE: u64 = 1 << 20;
 /// Longest reason of a known failure (it is copied into the reports of every case it matches).
 const MAX_REASON: usize = 1000;
 
-/// At most 60 characters of `text`, to quote it in an error.
-fn clip(text: &str) -> String {
-    let n = text.chars().count();
-    if n <= 60 {
-        text.to_owned()
-    } else {
-        format!(
-            "{}… ({n} characters)",
-            text.chars().take(60).collect::<String>()
-        )
-    }
-}
-
 /// One case pattern.
 #[derive(Debug, Clone)]
 pub struct Pattern {
@@ -66,7 +54,7 @@ impl Pattern {
         let text = text.trim().trim_end_matches('/').to_owned();
         if text.chars().count() > MAX_PATTERN {
             return Err(SelectError::Pattern {
-                pattern: clip(&text),
+                pattern: text.clone(),
                 why: format!("longer than {MAX_PATTERN} characters"),
             });
         }
@@ -226,14 +214,14 @@ impl Expectations {
                 return Err(bad(format!(
                     "failure {} ({}): the reason is empty",
                     i + 1,
-                    clip(&f.case)
+                    quote(&f.case)
                 )));
             }
             if f.reason.chars().count() > MAX_REASON {
                 return Err(bad(format!(
                     "failure {} ({}): the reason is longer than {MAX_REASON} characters",
                     i + 1,
-                    clip(&f.case)
+                    quote(&f.case)
                 )));
             }
             let p = Pattern::new(&f.case).map_err(|e| bad(format!("failure {}: {e}", i + 1)))?;

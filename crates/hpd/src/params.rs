@@ -2,6 +2,7 @@
 //! over consecutive addresses), `b99.14` (one bit), with values scaled as the keypad shows them.
 
 use crate::repr::{Data, Message};
+use drivespec_spec::quote::quote;
 use drivespec_spec::{Family, Parameter};
 
 /// Why a parameter reference or value is not usable.
@@ -38,11 +39,13 @@ pub enum ParamError {
         /// Bits in the parameter.
         bits: u32,
     },
-    /// A value that is not a number.
-    #[error("value {text:?} is not a number")]
+    /// A value the target cannot take.
+    #[error("value {}: {why}", quote(.text))]
     Value {
         /// The text given.
         text: String,
+        /// What is wrong with it.
+        why: &'static str,
     },
     /// A value outside the parameter's range.
     #[error("{id} = {value} outside range {range}")]
@@ -162,6 +165,7 @@ impl<'s> Target<'s> {
                     other => {
                         return Err(ParamError::Value {
                             text: other.to_owned(),
+                            why: "a bit is 0 or 1",
                         })
                     }
                 };
@@ -182,6 +186,7 @@ impl<'s> Target<'s> {
                 let raw = parse_value(p, value)?;
                 let data = Data::from_value(raw, 4).ok_or(ParamError::Value {
                     text: value.to_owned(),
+                    why: "does not fit a double word",
                 })?;
                 Ok(Message::WriteParam { addr, par, data })
             }
@@ -197,6 +202,7 @@ impl<'s> Target<'s> {
                 }
                 let data = Data::from_value(raw, lun).ok_or(ParamError::Value {
                     text: value.to_owned(),
+                    why: "does not fit the parameter's size",
                 })?;
                 Ok(Message::WriteParam { addr, par, data })
             }
@@ -223,18 +229,24 @@ pub fn bit_change(family: &Family, address: u8, bit: u32, value: bool) -> Option
 /// Parses a shown value (`25.3` for Pr33 with scale 0.1) into the raw value (`253`).
 pub fn parse_value(p: &Parameter, text: &str) -> Result<i64, ParamError> {
     let t = text.trim();
-    let bad = || ParamError::Value { text: t.to_owned() };
+    let bad = |why| ParamError::Value {
+        text: t.to_owned(),
+        why,
+    };
     if let Some(hex) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
-        return drivespec_spec::hex::parse_hex_digits(hex).ok_or_else(bad);
+        return drivespec_spec::hex::parse_hex_digits(hex)
+            .ok_or_else(|| bad("not a hex number of at most 32 bits"));
     }
     let scale = p.scale.unwrap_or(1.0);
     if scale == 1.0 {
-        return t.parse::<i64>().map_err(|_| bad());
+        return t
+            .parse::<i64>()
+            .map_err(|_| bad("not a whole number (the parameter has no decimals)"));
     }
-    let shown: f64 = t.parse().map_err(|_| bad())?;
+    let shown: f64 = t.parse().map_err(|_| bad("not a number"))?;
     let raw = (shown / scale).round();
     if !raw.is_finite() || raw.abs() > 4.0e9 {
-        return Err(bad());
+        return Err(bad("too large for any parameter"));
     }
     Ok(raw as i64)
 }

@@ -16,6 +16,7 @@ pub mod hex;
 mod load;
 mod model_values;
 mod parameter;
+pub mod quote;
 mod range;
 mod requirement;
 mod scenario;

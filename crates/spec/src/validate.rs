@@ -166,6 +166,14 @@ impl Validator<'_> {
                 let message = (*message).to_owned();
                 self.push(&p.file, rec.clone(), ProblemKind::Invalid { message });
             }
+            let scales = p
+                .scale
+                .iter()
+                .chain(p.modes.iter().filter_map(|m| m.scale.as_ref()));
+            for scale in scales.filter(|s| !s.is_finite() || **s == 0.0) {
+                let message = format!("scale {scale} is not a finite number other than 0");
+                self.push(&p.file, rec.clone(), ProblemKind::Invalid { message });
+            }
             if let (Some(range), Some((lo, hi))) = (&p.range, p.data_type.bounds()) {
                 for [min, max] in range.intervals() {
                     if min > max {

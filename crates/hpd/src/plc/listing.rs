@@ -3,6 +3,7 @@
 
 use super::codec::{Instr, Operands, PlcCodec};
 use drivespec_spec::hpd::OperandForm;
+use drivespec_spec::quote::quote;
 use std::fmt::Write as _;
 
 /// Why a listing line is not an instruction.
@@ -10,7 +11,7 @@ use std::fmt::Write as _;
 #[non_exhaustive]
 pub enum ListingError {
     /// Unknown mnemonic.
-    #[error("line {line}: unknown instruction {mnemonic:?}")]
+    #[error("line {line}: unknown instruction {}", quote(.mnemonic))]
     Mnemonic {
         /// 1-based line.
         line: usize,
@@ -18,7 +19,7 @@ pub enum ListingError {
         mnemonic: String,
     },
     /// Operands not of the instruction's form.
-    #[error("line {line}: {mnemonic} takes {expected}, found {found:?}")]
+    #[error("line {line}: {} takes {expected}, found {}", quote(.mnemonic), quote(.found))]
     Operands {
         /// 1-based line.
         line: usize,
