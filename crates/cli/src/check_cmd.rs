@@ -205,18 +205,16 @@ impl Bar {
 }
 
 fn write_reports(dir: &Path, reports: &[Report]) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, text) in [
+    let files: Vec<(std::path::PathBuf, String)> = [
         ("check.txt", render::text(reports)),
         ("check.json", render::json(reports)),
         ("check.xml", render::junit(reports)),
         ("check.html", render::html(reports)),
-    ] {
-        let path = dir.join(name);
-        let tmp = dir.join(format!(".{name}.tmp"));
-        std::fs::write(&tmp, text).with_context(|| format!("cannot write {}", tmp.display()))?;
-        std::fs::rename(&tmp, &path).with_context(|| format!("cannot write {}", path.display()))?;
-    }
+    ]
+    .into_iter()
+    .map(|(name, text)| (dir.join(name), text))
+    .collect();
+    drivespec_report::write_set(&files)?;
     Ok(())
 }
 

@@ -10,6 +10,8 @@
 
 use drivespec_testkit::{run, temp_dir};
 use std::io::Read;
+#[cfg(unix)]
+use std::os::unix::fs::FileTypeExt;
 use std::path::Path;
 use std::process::{Command, Stdio};
 
@@ -215,4 +217,75 @@ fn spec_scales_that_are_not_finite_or_zero_are_refused() {
             "{bad}: {stdout}"
         );
     }
+}
+
+#[cfg(unix)]
+#[test]
+fn report_paths_follow_symlinks_and_never_replace_a_device() {
+    let dir = temp_dir("hostile", "reports");
+    std::fs::create_dir_all(&dir).unwrap();
+    let real = dir.join("real.json");
+    let link = dir.join("link.json");
+    std::fs::write(&real, "old").unwrap();
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    let case = [
+        "conform",
+        "hpd",
+        "--case",
+        "hpd/frame/read-parameter",
+        "--quiet",
+    ];
+    let with = |extra: &[&str]| {
+        let mut args: Vec<&str> = case.to_vec();
+        args.extend_from_slice(extra);
+        run(BIN, &args)
+    };
+    let d = dir.to_str().unwrap();
+    let (code, _, stderr) = with(&["--report-dir", d, "--json", link.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read_to_string(&real)
+        .unwrap()
+        .contains("drivespec-conform/1"));
+    if Path::new("/dev/full").exists() {
+        let (code, _, stderr) = with(&["--report-dir", d, "--json", "/dev/full"]);
+        assert_eq!(code, 2, "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(std::fs::metadata("/dev/full")
+            .unwrap()
+            .file_type()
+            .is_char_device());
+    }
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(names.is_empty(), "temporary files left: {names:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_unwritable_report_folder_is_refused_before_the_run() {
+    let (code, stdout, stderr) = run(
+        BIN,
+        &[
+            "conform",
+            "all",
+            "--quiet",
+            "--report-dir",
+            "/proc/drivespec/none",
+        ],
+    );
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with("drivespec: cannot write /proc/drivespec/none/"),
+        "{stderr}"
+    );
+    assert!(!stdout.contains("passed"), "the run went ahead: {stdout}");
 }

@@ -204,6 +204,9 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             listed,
         });
     }
+    if !opts.no_reports {
+        drivespec_report::check_writable(&report_paths(opts)).map_err(write_error)?;
+    }
     let mut sessions: Vec<Box<dyn Session + '_>> = Vec::new();
     for s in &suites {
         sessions.push(s.open(&opts.dut)?);
@@ -556,35 +559,36 @@ fn coverage_row(req: &Requirement, suite: &[CaseInfo], results: &[CaseReport]) -
     }
 }
 
-fn write_reports(opts: &Options, report: &Report) -> Result<Vec<PathBuf>, ConformError> {
+/// The report files of a run: JUnit, JSON, HTML.
+fn report_paths(opts: &Options) -> [PathBuf; 3] {
     let dir = &opts.report_dir;
+    [
+        opts.junit
+            .clone()
+            .unwrap_or_else(|| dir.join("conform.junit.xml")),
+        opts.json
+            .clone()
+            .unwrap_or_else(|| dir.join("conform.json")),
+        opts.html
+            .clone()
+            .unwrap_or_else(|| dir.join("conform.html")),
+    ]
+}
+
+fn write_reports(opts: &Options, report: &Report) -> Result<Vec<PathBuf>, ConformError> {
+    let [junit, json, html] = report_paths(opts);
     let files = [
-        (
-            opts.junit
-                .clone()
-                .unwrap_or_else(|| dir.join("conform.junit.xml")),
-            report::junit(report),
-        ),
-        (
-            opts.json
-                .clone()
-                .unwrap_or_else(|| dir.join("conform.json")),
-            report.json(),
-        ),
-        (
-            opts.html
-                .clone()
-                .unwrap_or_else(|| dir.join("conform.html")),
-            report::html(report),
-        ),
+        (junit, report::junit(report)),
+        (json, report.json()),
+        (html, report::html(report)),
     ];
-    let mut written = Vec::new();
-    for (path, text) in files {
-        drivespec_report::write_atomic(&path, &text).map_err(|e| ConformError::Write {
-            file: path.display().to_string(),
-            why: e.to_string(),
-        })?;
-        written.push(path);
+    drivespec_report::write_set(&files).map_err(write_error)?;
+    Ok(files.into_iter().map(|(p, _)| p).collect())
+}
+
+fn write_error(e: drivespec_report::WriteError) -> ConformError {
+    ConformError::Write {
+        file: e.path.display().to_string(),
+        why: e.why.to_string(),
     }
-    Ok(written)
 }

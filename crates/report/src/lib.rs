@@ -13,7 +13,7 @@ pub mod plot;
 pub mod svg;
 
 pub use escape::escape;
-pub use file::write_atomic;
+pub use file::{check_writable, write_atomic, write_set, WriteError};
 
 /// `value` as pretty-printed JSON; a serialisation error becomes `{"error": "…"}`.
 pub fn json<T: serde::Serialize + ?Sized>(value: &T) -> String {

@@ -328,6 +328,14 @@ fn campaign(
     settings: &Settings,
     progress: &mut dyn Write,
 ) -> Result<Summary, FuzzError> {
+    if !opts.no_reports {
+        let names = ["fuzz.junit.xml", "fuzz.json", "fuzz.html"];
+        let paths: Vec<PathBuf> = names.iter().map(|n| opts.out_dir.join(n)).collect();
+        drivespec_report::check_writable(&paths).map_err(|e| FuzzError::Write {
+            file: e.path.display().to_string(),
+            why: e.why.to_string(),
+        })?;
+    }
     let family = target.family();
     let mode = opts.progress.resolve();
     let mut stats = Stats::new(family, settings.seed);
@@ -495,13 +503,11 @@ fn campaign(
                 report::html_with(&report, "drivespec fuzz", &output::html_section(&stats)),
             ),
         ];
-        for (path, text) in files {
-            drivespec_report::write_atomic(&path, &text).map_err(|e| FuzzError::Write {
-                file: path.display().to_string(),
-                why: e.to_string(),
-            })?;
-            written.push(path);
-        }
+        drivespec_report::write_set(&files).map_err(|e| FuzzError::Write {
+            file: e.path.display().to_string(),
+            why: e.why.to_string(),
+        })?;
+        written.extend(files.into_iter().map(|(p, _)| p));
         written.extend(findings.iter().filter_map(|f| f.file.clone()));
     }
     Ok(Summary {

@@ -21,6 +21,9 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// Largest replay file read (bytes): a minimised sequence is a few kilobytes.
+const MAX_REPLAY_FILE: u64 = 16 << 20;
+
 /// Name and version of the replay format (README "Replay files").
 pub const REPLAY_FORMAT: &str = "drivespec-fuzz-replay/1";
 
@@ -526,10 +529,13 @@ impl Replay {
     /// Reads a replay file.
     pub fn load(path: &Path) -> Result<Replay, ReplayError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ReplayError::Io {
-            file: file.clone(),
-            why: e.to_string(),
-        })?;
+        let text =
+            drivespec_spec::bounded::read_text_bounded(path, MAX_REPLAY_FILE).map_err(|e| {
+                ReplayError::Io {
+                    file: file.clone(),
+                    why: e.to_string(),
+                }
+            })?;
         Replay::from_json(&text, &file)
     }
 
@@ -537,7 +543,7 @@ impl Replay {
     pub fn save(&self, path: &Path) -> Result<(), ReplayError> {
         drivespec_report::write_atomic(path, &self.to_json()).map_err(|e| ReplayError::Io {
             file: path.display().to_string(),
-            why: e.to_string(),
+            why: e.why.to_string(),
         })
     }
 }
