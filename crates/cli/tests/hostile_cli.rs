@@ -289,3 +289,82 @@ fn an_unwritable_report_folder_is_refused_before_the_run() {
     );
     assert!(!stdout.contains("passed"), "the run went ahead: {stdout}");
 }
+
+/// Runs `args` under a Python wrapper that reports the peak resident memory of the run (KB).
+fn run_measured(args: &[&str]) -> (i32, String, u64) {
+    const WRAP: &str = "import resource, subprocess, sys\n\
+        r = subprocess.run(sys.argv[1:], stdout=subprocess.PIPE)\n\
+        sys.stdout.buffer.write(r.stdout)\n\
+        print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, file=sys.stderr)\n\
+        sys.exit(r.returncode)\n";
+    let mut all = vec!["-c", WRAP, BIN];
+    all.extend_from_slice(args);
+    let out = Command::new("python3").args(&all).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let kb = stderr
+        .lines()
+        .last()
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or(u64::MAX);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        kb,
+    )
+}
+
+#[cfg(unix)]
+#[test]
+fn a_device_flooding_the_line_fails_with_bounded_evidence_and_memory() {
+    let relay = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/flooding_hpd_relay.py");
+    let dut = format!("exec:python3 {} {BIN} sim hpd --stdio", relay.display());
+    let dir = temp_dir("hostile", "flood");
+    let (code, stdout, kb) = run_measured(&[
+        "conform",
+        "hpd",
+        "--quiet",
+        "--dut",
+        &dut,
+        "--case",
+        "hpd/frame/*",
+        "--report-dir",
+        dir.to_str().unwrap(),
+    ]);
+    let json = std::fs::read_to_string(dir.join("conform.json")).unwrap_or_default();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(kb < 200_000, "peak memory {kb} KB");
+    assert!(
+        json.len() < 20_000_000,
+        "JSON report of {} bytes",
+        json.len()
+    );
+    assert!(
+        json.contains("bytes)"),
+        "no shortened evidence in the report"
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn a_reply_line_without_end_is_cut_at_the_line_limit() {
+    let relay = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/endless_line_relay.py");
+    let dut = format!("exec:python3 {} {BIN} sim psd4xx --stdio", relay.display());
+    let dir = temp_dir("hostile", "endless");
+    let (code, stdout, kb) = run_measured(&[
+        "conform",
+        "psd4xx",
+        "--quiet",
+        "--dut",
+        &dut,
+        "--case",
+        "psd4xx/pkw/read/1",
+        "--report-dir",
+        dir.to_str().unwrap(),
+    ]);
+    let json = std::fs::read_to_string(dir.join("conform.json")).unwrap_or_default();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(kb < 200_000, "peak memory {kb} KB");
+    assert!(json.contains("no line end within 4096 bytes"), "{json}");
+}

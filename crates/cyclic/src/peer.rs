@@ -149,9 +149,10 @@ impl Peer for LinkPeer {
                     partial: String::from_utf8_lossy(&self.buf).into_owned(),
                 });
             }
-            let have = self.buf.clone();
+            // The line limit holds while reading: a reply without end stops the wait.
+            let have = self.buf.len();
             let chunks = self.link.recv(deadline, &mut |b: &[u8]| {
-                b.contains(&b'\n') || have.contains(&b'\n')
+                b.contains(&b'\n') || have.saturating_add(b.len()) > MAX_LINE
             })?;
             for c in chunks {
                 self.buf.extend_from_slice(&c.bytes);

@@ -16,6 +16,8 @@ use std::time::Duration;
 
 /// Most stderr bytes kept for the evidence.
 const STDERR_KEEP: usize = 4096;
+/// Output chunks (of up to 512 bytes each) read ahead of the session.
+const CHUNKS_QUEUED: usize = 256;
 
 /// A running subprocess and the threads that move its bytes.
 struct Proc {
@@ -124,7 +126,8 @@ fn start(argv: &[String], clock: WallClock) -> Result<Proc, LinkError> {
         };
     let (to_child, rx) = mpsc::channel::<Vec<u8>>();
     std::thread::spawn(move || writer(stdin, rx));
-    let (tx, from_child) = mpsc::channel();
+    // Bounded: a process that floods its output blocks on the pipe instead of filling memory.
+    let (tx, from_child) = mpsc::sync_channel(CHUNKS_QUEUED);
     std::thread::spawn(move || {
         let mut stdout = stdout;
         let mut buf = [0u8; 512];
@@ -232,7 +235,7 @@ impl Link for ExecLink {
                     self.fresh = false;
                     all.extend_from_slice(&bytes);
                     chunks.push(Chunk { at, bytes });
-                    if enough(&all) {
+                    if all.len() >= crate::MAX_RECV || enough(&all) {
                         break;
                     }
                 }

@@ -15,8 +15,9 @@
 //! monotonic wall clock ([`WallClock`]); an in-process model's clock is virtual and only moves
 //! when the runner waits.
 //!
-//! Nothing here panics. Memory is bounded by what a peer sends before a deadline; every
-//! buffer a peer fills is read in bounded slices.
+//! Nothing here panics. Memory is bounded whatever a peer sends: one `recv` returns at most
+//! [`MAX_RECV`] bytes, a subprocess's output is read ahead in a bounded queue, and every buffer
+//! a peer fills is read in bounded slices.
 #![forbid(unsafe_code)]
 
 mod exec;
@@ -37,6 +38,10 @@ pub use tcp::TcpLink;
 
 /// Time in µs on a link's clock.
 pub type Micros = u64;
+
+/// Most bytes one [`Link::recv`] returns: a device flooding the line is judged on what fits,
+/// and memory stays bounded whatever it sends.
+pub const MAX_RECV: usize = 64 * 1024;
 
 /// Why a transport operation failed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -129,7 +129,7 @@ impl Link for SerialLink {
                         at: clock.now(),
                         bytes,
                     });
-                    if enough(&all) {
+                    if all.len() >= crate::MAX_RECV || enough(&all) {
                         break;
                     }
                 }

@@ -124,7 +124,7 @@ impl Link for TcpLink {
                         at: clock.now(),
                         bytes,
                     });
-                    if enough(&all) {
+                    if all.len() >= crate::MAX_RECV || enough(&all) {
                         break;
                     }
                 }

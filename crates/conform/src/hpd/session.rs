@@ -20,6 +20,10 @@ use drivespec_hpd::params::Target;
 use drivespec_hpd::{LineDecoder, LineEvent, Message};
 use drivespec_spec::hex::to_hex;
 
+/// Most bytes of one answer kept whole in the evidence; a longer one keeps its start and its
+/// last 64 bytes.
+const EVIDENCE_BYTES: usize = 512;
+
 /// A session on one device under test.
 pub struct HpdSession<'a, 's> {
     suite: &'a HpdSuite<'s>,
@@ -242,14 +246,31 @@ impl<'a, 's> HpdSession<'a, 's> {
         parts.join("; ")
     }
 
+    /// The evidence of what came: all of it up to [`EVIDENCE_BYTES`], else its start and end
+    /// with the count (a device flooding the line).
     fn answer(&self, chunks: &[Chunk], t0: Micros, request: Option<&Message>) -> Answer {
         let bytes = concat(chunks);
         if bytes.is_empty() {
             return Answer::silence();
         }
+        let n = bytes.len();
+        let (hex, text) = match (
+            bytes.get(..EVIDENCE_BYTES),
+            bytes.get(n.saturating_sub(64)..),
+        ) {
+            (Some(head), Some(tail)) if n > EVIDENCE_BYTES => (
+                format!("{} … {} ({n} bytes)", to_hex(head), to_hex(tail)),
+                format!(
+                    "{}; and {} more byte(s)",
+                    self.words(head, request),
+                    n - EVIDENCE_BYTES
+                ),
+            ),
+            _ => (to_hex(&bytes), self.words(&bytes, request)),
+        };
         Answer {
-            hex: to_hex(&bytes),
-            text: self.words(&bytes, request),
+            hex,
+            text,
             delay_us: chunks.first().map(|c| c.at.saturating_sub(t0)),
         }
     }
@@ -618,7 +639,7 @@ impl HpdSession<'_, '_> {
                         Ok(obs) => {
                             let ea = self.answer(&obs.expected, obs.t0, last_request.as_ref());
                             let ga = self.answer(&obs.got, obs.t0, last_request.as_ref());
-                            let ok = ea.hex == ga.hex;
+                            let ok = concat(&obs.expected) == concat(&obs.got);
                             let why = format!(
                                 "expected {} while listening, got {}",
                                 show(&ea),
