@@ -24,4 +24,6 @@ pub mod synth;
 pub mod timeline;
 
 pub use error::SetupError;
-pub use report::{Catalog, Evidence, Report, Violation, Where};
+pub use report::{
+    Catalog, Evidence, Report, Violation, Where, DEFAULT_MAX_VIOLATIONS, MAX_LISTED_PER_REQUIREMENT,
+};

@@ -133,6 +133,12 @@ pub fn text(reports: &[Report]) -> String {
                     );
                 }
             }
+            for (id, t) in &r.requirements {
+                let shown = r.violations.iter().filter(|v| v.requirement == *id).count() as u64;
+                if t.violations > shown {
+                    let _ = writeln!(o, "    … and {} more of {id}", t.violations - shown);
+                }
+            }
         }
         for n in &r.notes {
             let _ = writeln!(o, "  note: {n}");

@@ -2,7 +2,8 @@
 //! requirement, frame counts, cycle statistics and what was detected (schema in the crate
 //! README, "JSON report").
 //!
-//! Memory is bounded: at most `max_violations` violations are listed (all are counted), the
+//! Memory is bounded: at most `max_violations` violations are listed, and at most
+//! [`MAX_LISTED_PER_REQUIREMENT`] of one requirement (all are counted), the
 //! requirement tallies are bounded by the catalogue, notes by [`MAX_NOTES`], and timelines
 //! by [`crate::timeline::MAX_SAMPLES`]. Nothing here panics.
 
@@ -434,7 +435,16 @@ pub struct Recorder {
     catalog: Arc<Catalog>,
     report: Report,
     max: Option<u64>,
+    /// Violations listed per requirement.
+    listed: HashMap<String, u64>,
 }
+
+/// Violations listed by default (all are counted): a capture full of one fault must not fill
+/// memory or the terminal.
+pub const DEFAULT_MAX_VIOLATIONS: u64 = 1000;
+
+/// Most violations of one requirement listed, so one repeated fault does not hide the others.
+pub const MAX_LISTED_PER_REQUIREMENT: u64 = 100;
 
 impl Recorder {
     /// A recorder for a `family` report listing at most `max` violations.
@@ -445,6 +455,7 @@ impl Recorder {
             catalog,
             report,
             max,
+            listed: HashMap::new(),
         }
     }
 
@@ -484,10 +495,13 @@ impl Recorder {
         let t = self.tally(id);
         t.violations += 1;
         let (level, text, source) = (t.level.clone(), t.text.clone(), t.source.clone());
-        if self
-            .max
-            .is_none_or(|m| (self.report.violations.len() as u64) < m)
+        let of_this = self.listed.get(id).copied().unwrap_or(0);
+        if of_this < MAX_LISTED_PER_REQUIREMENT
+            && self
+                .max
+                .is_none_or(|m| (self.report.violations.len() as u64) < m)
         {
+            *self.listed.entry(id.to_owned()).or_insert(0) += 1;
             self.report.violations.push(Violation {
                 requirement: id.to_owned(),
                 level,

@@ -41,9 +41,10 @@ pub struct CheckArgs {
     /// Do not search cyclic frames for PSD4xx process data without a Connect.
     #[arg(long)]
     no_search: bool,
-    /// List at most N violations per file (all are counted).
-    #[arg(long, value_name = "N")]
-    max_violations: Option<u64>,
+    /// List at most N violations per file, and at most 100 of one requirement (all are
+    /// counted).
+    #[arg(long, value_name = "N", default_value_t = drivespec_check::DEFAULT_MAX_VIOLATIONS)]
+    max_violations: u64,
     /// Report format on stdout (the global `--format json` selects json too).
     #[arg(long, value_enum)]
     report: Option<ReportArg>,
@@ -135,9 +136,9 @@ fn options(args: &CheckArgs) -> Result<RunOptions> {
         ..RunOptions::default()
     };
     o.hpd.baud = args.baud;
-    o.hpd.max_violations = args.max_violations;
-    o.pn.max_violations = args.max_violations;
-    o.psx.max_violations = args.max_violations;
+    o.hpd.max_violations = Some(args.max_violations);
+    o.pn.max_violations = Some(args.max_violations);
+    o.psx.max_violations = Some(args.max_violations);
     o.pn.psd.model = args.model.clone();
     o.psx.model = args.model.clone();
     o.pn.search = !args.no_search;

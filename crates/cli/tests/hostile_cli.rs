@@ -368,3 +368,26 @@ fn a_reply_line_without_end_is_cut_at_the_line_limit() {
     assert!(kb < 200_000, "peak memory {kb} KB");
     assert!(json.contains("no line end within 4096 bytes"), "{json}");
 }
+
+#[test]
+fn a_capture_full_of_one_fault_lists_a_bounded_number() {
+    let dir = temp_dir("hostile", "zeros");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("zeros.pcap");
+    // pcap header (Ethernet), then 500,000 empty records.
+    let mut bytes = Vec::new();
+    for v in [0xa1b2_c3d4u32, 0x0004_0002, 0, 0, 65535, 1] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    bytes.resize(bytes.len() + 500_000 * 16, 0);
+    std::fs::write(&file, &bytes).unwrap();
+    let (code, stdout, kb) = run_measured(&["check", file.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(kb < 200_000, "peak memory {kb} KB");
+    assert!(
+        stdout.contains("… and 499900 more of PN-FRAME-001"),
+        "{stdout}"
+    );
+    assert!(stdout.len() < 100_000, "{} bytes of output", stdout.len());
+}
