@@ -140,13 +140,36 @@ impl<R: Read> Read for Counting<R> {
 /// Events between two progress calls.
 const PROGRESS_EVERY: u64 = 16_384;
 
-fn open(path: &Path) -> Result<(File, Option<u64>), RunError> {
-    let f = File::open(path).map_err(|source| RunError::Open {
+/// Bytes of the input's start that detection looks at; the check reads them again, followed
+/// by the rest, so the input is opened and read once (a pipe or FIFO works like a file).
+const PEEK: u64 = 1 << 16;
+
+/// An opened input: the rest after its start, its size when known, and its first bytes.
+type Opened = (Box<dyn Read>, Option<u64>, Vec<u8>);
+
+/// The input named `path` (`-`: standard input), opened once.
+fn open(path: &Path) -> Result<Opened, RunError> {
+    let failed = |source| RunError::Open {
         path: path.to_owned(),
         source,
-    })?;
-    let len = f.metadata().ok().map(|m| m.len());
-    Ok((f, len))
+    };
+    let (mut input, len): (Box<dyn Read>, Option<u64>) = if path == Path::new("-") {
+        (Box::new(io::stdin()), None)
+    } else {
+        let f = File::open(path).map_err(failed)?;
+        let meta = f.metadata().map_err(failed)?;
+        if meta.is_dir() {
+            return Err(unreadable(path, "a folder, not a recording"));
+        }
+        (Box::new(f), meta.is_file().then_some(meta.len()))
+    };
+    let mut start = Vec::new();
+    input
+        .by_ref()
+        .take(PEEK)
+        .read_to_end(&mut start)
+        .map_err(failed)?;
+    Ok((input, len, start))
 }
 
 fn unreadable(path: &Path, reason: impl Into<String>) -> RunError {
@@ -169,9 +192,13 @@ enum Plan {
     Csv,
 }
 
-fn plan(path: &Path, options: &RunOptions, notes: &mut Vec<String>) -> Result<Plan, RunError> {
-    let (f, _) = open(path)?;
-    let input = Input::open(BufReader::new(f)).map_err(|e| unreadable(path, e.to_string()))?;
+fn plan(
+    path: &Path,
+    start: &[u8],
+    options: &RunOptions,
+    notes: &mut Vec<String>,
+) -> Result<Plan, RunError> {
+    let input = Input::open(start).map_err(|e| unreadable(path, e.to_string()))?;
     let detection = input.detection().clone();
     drop(input);
     let detected = detection.format;
@@ -183,9 +210,7 @@ fn plan(path: &Path, options: &RunOptions, notes: &mut Vec<String>) -> Result<Pl
                 format!("not a pcap or pcapng capture: detected {detection}"),
             ));
         }
-        let (f, _) = open(path)?;
-        let mut r =
-            CaptureReader::new(BufReader::new(f)).map_err(|e| unreadable(path, e.to_string()))?;
+        let mut r = CaptureReader::new(start).map_err(|e| unreadable(path, e.to_string()))?;
         let link = match r.next_record() {
             Ok(Some(rec)) => Some(rec.link_type),
             _ => None,
@@ -265,13 +290,13 @@ pub fn check_path(
 ) -> Result<Report, RunError> {
     let catalog = Arc::new(Catalog::new(spec).map_err(SetupError::from)?);
     let mut notes = Vec::new();
-    let plan = plan(path, options, &mut notes)?;
-    let (f, total) = open(path)?;
+    let (rest, total, start) = open(path)?;
+    let plan = plan(path, &start, options, &mut notes)?;
     let count = Rc::new(Cell::new(0u64));
     let reader = BufReader::with_capacity(
         1 << 16,
         Counting {
-            inner: f,
+            inner: io::Cursor::new(start).chain(rest),
             count: count.clone(),
         },
     );
@@ -312,18 +337,15 @@ pub fn check_path(
         }
         Plan::Jsonl | Plan::Csv => {
             let mut c = IoLinkChecker::with_catalog(spec, options.psx.clone(), catalog)?;
-            let input = Input::open(reader).map_err(|e| unreadable(path, e.to_string()))?;
+            let forced = |r| Input::open(r).map_err(|e| unreadable(path, e.to_string()));
             let lines: Box<dyn Iterator<Item = _>> = match (plan, options.format) {
-                (Plan::Jsonl, InputFormat::Jsonl) => Box::new(JsonLinesReader::new(input)),
-                (Plan::Csv, InputFormat::Csv) => Box::new(CsvReader::new(input)),
-                _ => {
-                    drop(input);
-                    let (f, _) = open(path)?;
-                    Box::new(
-                        IoLinkReader::open(BufReader::new(f))
-                            .map_err(|e| unreadable(path, e.to_string()))?,
-                    )
+                (Plan::Jsonl, InputFormat::Jsonl) => {
+                    Box::new(JsonLinesReader::new(forced(reader)?))
                 }
+                (Plan::Csv, InputFormat::Csv) => Box::new(CsvReader::new(forced(reader)?)),
+                _ => Box::new(
+                    IoLinkReader::open(reader).map_err(|e| unreadable(path, e.to_string()))?,
+                ),
             };
             let mut n = 0u64;
             for item in lines {

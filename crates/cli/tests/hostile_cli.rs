@@ -391,3 +391,34 @@ fn a_capture_full_of_one_fault_lists_a_bounded_number() {
     );
     assert!(stdout.len() < 100_000, "{} bytes of output", stdout.len());
 }
+
+#[cfg(unix)]
+#[test]
+fn a_recording_through_a_pipe_or_fifo_gets_the_verdict_of_the_file() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../corpus/captures/hpd-faults.txt");
+    let (code, stdout, _) = run(BIN, &["check", file.to_str().unwrap()]);
+    assert_eq!(code, 1, "{stdout}");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let (piped, piped_out, stderr) =
+        drivespec_testkit::run_with(BIN, &["check", "-"], Some(&text), &[]);
+    assert_eq!(piped, 1, "{piped_out}{stderr}");
+    let tail = |s: &str| s.lines().skip(1).collect::<Vec<_>>().join("\n");
+    assert_eq!(tail(&piped_out), tail(&stdout));
+    let dir = temp_dir("hostile", "fifo");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("capture.txt");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let writer = {
+        let (fifo, text) = (fifo.clone(), text.clone());
+        std::thread::spawn(move || std::fs::write(fifo, text))
+    };
+    let (code, fifo_out, stderr) = run(BIN, &["check", fifo.to_str().unwrap()]);
+    writer.join().unwrap().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{fifo_out}{stderr}");
+    assert_eq!(tail(&fifo_out), tail(&stdout));
+}
