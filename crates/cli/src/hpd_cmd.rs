@@ -1,7 +1,7 @@
 //! `drivespec decode|encode|plc hpd …`: the HPD serial protocol and pico-PLC from the command line.
 
-use crate::{json, Context, Format, Outcome};
-use anyhow::{anyhow, bail, Context as _, Result};
+use crate::{input, json, Context, Format, Outcome};
+use anyhow::{anyhow, bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use drivespec_hpd::explain::{explain, Explained};
 use drivespec_hpd::params::Target;
@@ -10,11 +10,7 @@ use drivespec_hpd::{Data, Exchange, FrameRules, LineDecoder, LineEvent, Message,
 use drivespec_spec::hex::{parse_hex, parse_int, to_hex};
 use drivespec_spec::{Family, FamilyId, Spec};
 use serde::Serialize;
-use std::io::Read as _;
 use std::path::PathBuf;
-
-/// Largest input read by `--stream` (bytes).
-const MAX_STREAM: u64 = 1 << 30;
 
 /// Arguments of `drivespec decode hpd`.
 #[derive(Args)]
@@ -218,20 +214,8 @@ fn decoded_text(out: &Decoded, stream: bool) -> String {
     s
 }
 
-fn read_stream(path: &PathBuf, format: StreamFormat) -> Result<Vec<u8>> {
-    let mut raw = Vec::new();
-    if path.as_os_str() == "-" {
-        std::io::stdin()
-            .take(MAX_STREAM)
-            .read_to_end(&mut raw)
-            .context("cannot read standard input")?;
-    } else {
-        let f =
-            std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
-        f.take(MAX_STREAM)
-            .read_to_end(&mut raw)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-    }
+fn read_stream(path: &std::path::Path, format: StreamFormat) -> Result<Vec<u8>> {
+    let raw = input::read_bytes(path, input::MAX_STREAM)?;
     let as_hex = || {
         std::str::from_utf8(&raw)
             .ok()
@@ -448,17 +432,7 @@ pub fn plc(args: PlcArgs, ctx: &Context) -> Result<Outcome> {
     let is_default = matches!(args.what, PlcWhat::Default);
     let (program, bytes) = match args.what {
         PlcWhat::Asm { file } => {
-            let text = if file.as_os_str() == "-" {
-                let mut s = String::new();
-                std::io::stdin()
-                    .take(MAX_STREAM)
-                    .read_to_string(&mut s)
-                    .context("cannot read standard input")?;
-                s
-            } else {
-                std::fs::read_to_string(&file)
-                    .with_context(|| format!("cannot read {}", file.display()))?
-            };
+            let text = input::read_text(&file, input::MAX_TEXT)?;
             let program = codec.parse_listing(&text)?;
             let bytes = codec.encode_program(&program)?;
             (program, bytes)

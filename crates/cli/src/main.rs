@@ -23,6 +23,7 @@ mod check_cmd;
 mod conform_cmd;
 mod fuzz_cmd;
 mod hpd_cmd;
+mod input;
 mod pd_cmd;
 mod sim_cmd;
 mod simrun_cmd;

@@ -1,7 +1,7 @@
 //! `drivespec decode|encode psd4xx|psx3xx …`: process images field by field.
 
-use crate::{json, Context, Format, Outcome};
-use anyhow::{anyhow, Context as _, Result};
+use crate::{input, json, Context, Format, Outcome};
+use anyhow::{anyhow, Result};
 use clap::Args;
 use drivespec_positioner::ByteOrder;
 use drivespec_spec::hex::{parse_hex, parse_int, to_hex};
@@ -214,8 +214,7 @@ pub fn decode_psx3xx(args: Psx3xxDecode, ctx: &Context) -> Result<Outcome> {
         None => None,
     };
     if let Some(path) = &args.detect_order {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = input::read_text(path, input::MAX_TEXT)?;
         let mut images = Vec::new();
         for (i, line) in text
             .lines()

@@ -2,7 +2,7 @@
 //! family's reference model and prints the trace (the library does the work:
 //! `drivespec_psd4xx::script`, `drivespec_psx3xx::script`, grammar in `drivespec_positioner::script`).
 
-use crate::{json, Context, Format, Outcome};
+use crate::{input, json, Context, Format, Outcome};
 use anyhow::{bail, Context as _, Result};
 use drivespec_positioner::script::{RunOptions, Trace};
 use drivespec_psd4xx::model::DriveConfig;
@@ -35,12 +35,7 @@ pub struct SimRunArgs {
 
 /// Runs `drivespec sim-run`; exit 1 when an `expect` line fails.
 pub fn run(args: SimRunArgs, ctx: &Context) -> Result<Outcome> {
-    let text = if args.script.as_os_str() == "-" {
-        std::io::read_to_string(std::io::stdin()).context("cannot read the script from stdin")?
-    } else {
-        std::fs::read_to_string(&args.script)
-            .with_context(|| format!("cannot read script {}", args.script.display()))?
-    };
+    let text = input::read_text(&args.script, input::MAX_TEXT)?;
     if args.cycle_us == 0 {
         bail!("--cycle-us 0: the bus cycle is at least 1 µs");
     }

@@ -422,3 +422,42 @@ fn a_recording_through_a_pipe_or_fifo_gets_the_verdict_of_the_file() {
     assert_eq!(code, 1, "{fifo_out}{stderr}");
     assert_eq!(tail(&fifo_out), tail(&stdout));
 }
+
+#[cfg(unix)]
+#[test]
+fn inputs_that_never_end_stop_at_their_limit() {
+    for args in [
+        &["decode", "hpd", "--stream", "/dev/zero"][..],
+        &["decode", "psx3xx", "--detect-order", "/dev/zero", "--in"][..],
+        &["plc", "hpd", "asm", "/dev/zero"][..],
+        &[
+            "sim-run",
+            "psd4xx",
+            "--model",
+            "PSD426",
+            "--script",
+            "/dev/zero",
+        ][..],
+    ] {
+        let (code, stdout, kb) = run_measured(args);
+        assert_eq!(code, 2, "{args:?}: {stdout}");
+        assert!(kb < 200_000, "{args:?}: peak memory {kb} KB");
+    }
+}
+
+#[test]
+fn a_script_time_past_the_longest_run_is_refused_naming_the_line() {
+    let script = "0 ms: control 0x14 target 2000\n1000000000 s: end\n";
+    let (code, _, stderr) = drivespec_testkit::run_with(
+        BIN,
+        &["sim-run", "psd4xx", "--model", "PSD426", "--script", "-"],
+        Some(script),
+        &[],
+    );
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("line 2: time 1000000000000000 µs is past the longest script, 3600 s"),
+        "{stderr}"
+    );
+}

@@ -53,6 +53,12 @@ pub enum LineError {
         /// The previous line's time, µs.
         previous: Micros,
     },
+    /// The time is past the longest script ([`MAX_SCRIPT_US`]).
+    #[error("time {at} µs is past the longest script, {} s of simulated time", MAX_SCRIPT_US / 1_000_000)]
+    TooLate {
+        /// This line's time, µs.
+        at: Micros,
+    },
     /// Nothing after the colon.
     #[error("no command after the time")]
     Empty,
@@ -285,12 +291,20 @@ fn parse_time(text: &str, previous: Micros) -> Result<Micros, LineError> {
         return Err(bad());
     }
     let us = us as Micros;
-    Ok(if relative {
+    let at = if relative {
         previous.saturating_add(us)
     } else {
         us
-    })
+    };
+    if at > MAX_SCRIPT_US {
+        return Err(LineError::TooLate { at });
+    }
+    Ok(at)
 }
+
+/// The latest time a script line may name: one hour of simulated time (3.6 million 1 ms bus
+/// cycles), so a run and its trace stay bounded.
+pub const MAX_SCRIPT_US: Micros = 3_600_000_000;
 
 fn parse_action<D: Dialect>(command: &str, dialect: &D) -> Result<Action<D::Command>, LineError> {
     let (verb, rest) = split_word(command);
