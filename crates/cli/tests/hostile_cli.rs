@@ -461,3 +461,27 @@ fn a_script_time_past_the_longest_run_is_refused_naming_the_line() {
         "{stderr}"
     );
 }
+
+#[cfg(unix)]
+#[test]
+fn a_device_that_never_answers_stops_the_run_as_a_set_up_error() {
+    let dir = temp_dir("hostile", "mute");
+    let (code, _, stderr) = run(
+        BIN,
+        &[
+            "conform",
+            "hpd",
+            "--quiet",
+            "--dut",
+            "exec:sleep 600",
+            "--report-dir",
+            dir.to_str().unwrap(),
+        ],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 2, "{stderr}");
+    assert_eq!(
+        stderr,
+        "drivespec: the device under test answered nothing in the first 10 cases (exec:sleep 600): check --dut, the bit rate and --address\n"
+    );
+}

@@ -21,6 +21,10 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// Failing cases without a single byte from the device after which a run stops as a set-up
+/// error: a wrong port, bit rate or address would otherwise cost the whole suite's time-outs.
+const MUTE_CASES: usize = 10;
+
 /// How progress is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Progress {
@@ -124,6 +128,15 @@ pub enum ConformError {
     /// A suite or the transport could not be set up.
     #[error(transparent)]
     Setup(#[from] SetupError),
+    /// The device answered nothing at all in the first cases: the transport, bit rate or
+    /// address is wrong, not the device.
+    #[error("the device under test answered nothing in the first {cases} cases ({dut}): check --dut, the bit rate and --address")]
+    Mute {
+        /// Cases run.
+        cases: usize,
+        /// The device under test.
+        dut: String,
+    },
     /// A report could not be written.
     #[error("cannot write {file}: {why}")]
     Write {
@@ -215,6 +228,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     let mode = opts.progress.resolve();
     let mut results: Vec<CaseReport> = Vec::new();
     let mut stop = false;
+    let mut heard = false;
     let total = plan.len();
     for (n, (si, ci)) in plan.iter().enumerate() {
         let (Some(suite), Some(session)) = (suites.get(*si), sessions.get_mut(*si)) else {
@@ -237,6 +251,17 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         }
         let started = Instant::now();
         let run = session.run(*ci);
+        let answered = run
+            .evidence
+            .iter()
+            .any(|r| r.got.as_ref().is_some_and(|a| !a.is_silence()));
+        heard |= answered || !run.outcome.failed();
+        if !heard && n + 1 >= MUTE_CASES {
+            return Err(ConformError::Mute {
+                cases: n + 1,
+                dut: opts.dut.to_string(),
+            });
+        }
         let wall_ms = started.elapsed().as_secs_f64() * 1000.0;
         let status = match (&run.outcome, known) {
             (Outcome::Pass, None) if run.findings.is_empty() => Status::Pass,
