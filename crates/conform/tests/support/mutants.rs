@@ -33,6 +33,8 @@ pub enum Kind {
     BigEndian,
     NoStuffing,
     ReadOnlyWritable,
+    /// Pr23 and Pr24 take a master's write.
+    AlarmsWritable,
     PlcWritableWhileRunning,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
@@ -82,16 +84,29 @@ impl Mutant {
         }
     }
 
-    fn value_in_range(&self, p: &drivespec_spec::Parameter, v: i64) -> bool {
+    fn mode(&self) -> u32 {
         let family = spec().family(FamilyId::Hpd);
-        let mode = family
+        family
             .parameter("Pr31")
             .and_then(|m| self.inner.value(&Target::Param(m)).ok())
-            .unwrap_or(0);
+            .unwrap_or(0) as u32
+    }
+
+    /// Whether `p` is read-only in the operating mode in force (Pr55 in mode 2).
+    fn read_only_in_mode(&self, p: &drivespec_spec::Parameter) -> bool {
+        let mode = self.mode();
+        p.modes
+            .iter()
+            .any(|e| e.modes.contains(&mode) && e.access.is_some_and(|a| !a.writable()))
+    }
+
+    fn value_in_range(&self, p: &drivespec_spec::Parameter, v: i64) -> bool {
+        let family = spec().family(FamilyId::Hpd);
+        let mode = self.mode();
         let range = p
             .modes
             .iter()
-            .find(|e| e.modes.contains(&(mode as u32)))
+            .find(|e| e.modes.contains(&mode))
             .and_then(|e| e.range.clone())
             .or_else(|| family.resolve(p, None).range);
         range.is_none_or(|r| r.contains(v))
@@ -113,7 +128,8 @@ impl Mutant {
         let v = t.value(data);
         let take = match self.kind {
             Kind::IgnoresRanges => p.access.writable() && !self.value_in_range(p, v),
-            Kind::ReadOnlyWritable => !p.access.writable(),
+            Kind::ReadOnlyWritable => !p.access.writable() || self.read_only_in_mode(p),
+            Kind::AlarmsWritable => ["Pr23", "Pr24"].contains(&p.id.as_str()),
             _ => false,
         };
         if take {
@@ -196,7 +212,7 @@ impl Mutant {
                 return;
             }
             (
-                Kind::IgnoresRanges | Kind::ReadOnlyWritable,
+                Kind::IgnoresRanges | Kind::ReadOnlyWritable | Kind::AlarmsWritable,
                 Some(Message::WriteParam { addr, par, data }),
             ) if addr == own => {
                 self.inner.handle_rx(now, bytes);
@@ -437,7 +453,20 @@ pub fn mutants() -> Vec<Case> {
             name: "read-only parameters writable",
             kind: Kind::ReadOnlyWritable,
             breaks: read_only,
-            must_fail: &["hpd/param/Pr25/write-refused"],
+            must_fail: &[
+                "hpd/param/Pr25/write-refused",
+                "hpd/param/Pr23/write-refused",
+                "hpd/param/Pr55/mode-2/max",
+            ],
+        },
+        Case {
+            name: "alarm codes writable",
+            kind: Kind::AlarmsWritable,
+            breaks: v(&["HPD-ALARM-010"]),
+            must_fail: &[
+                "hpd/param/Pr23/write-refused",
+                "hpd/param/Pr24/write-refused",
+            ],
         },
         Case {
             name: "PLC writable while running",
