@@ -285,9 +285,15 @@ impl<'s> Gen<'s> {
     }
 
     /// Requirements a correct request of this kind exercises (manual 4.1 table), with the
-    /// answer the reference gives.
+    /// answer the reference gives. A write's answer is only the acknowledge, so its rule
+    /// (HPD-FRAME-011) comes first: a missing or malformed acknowledge breaks it.
     fn auto_reqs(&self, msg: &Message, bytes: &[u8]) -> Vec<&'static str> {
-        let mut r: Vec<&'static str> = vec!["HPD-FRAME-001", "HPD-FRAME-006"];
+        let mut r: Vec<&'static str> = match msg.kind() {
+            MessageKind::WriteParam | MessageKind::BitChange | MessageKind::WritePlc => {
+                vec!["HPD-FRAME-011", "HPD-FRAME-001", "HPD-FRAME-006"]
+            }
+            _ => vec!["HPD-FRAME-001", "HPD-FRAME-006"],
+        };
         match msg.kind() {
             MessageKind::ReadParam => r.extend([
                 "HPD-FRAME-014",
@@ -297,25 +303,17 @@ impl<'s> Gen<'s> {
                 "HPD-SERIAL-017",
                 "HPD-SERIAL-015",
             ]),
-            MessageKind::WriteParam => r.extend([
-                "HPD-FRAME-015",
-                "HPD-FRAME-011",
-                "HPD-FRAME-008",
-                "HPD-SERIAL-015",
-            ]),
-            MessageKind::BitChange => r.extend([
-                "HPD-FRAME-016",
-                "HPD-FRAME-017",
-                "HPD-FRAME-018",
-                "HPD-FRAME-011",
-            ]),
+            MessageKind::WriteParam => {
+                r.extend(["HPD-FRAME-015", "HPD-FRAME-008", "HPD-SERIAL-015"])
+            }
+            MessageKind::BitChange => r.extend(["HPD-FRAME-016", "HPD-FRAME-017", "HPD-FRAME-018"]),
             MessageKind::ReadPlc => r.extend([
                 "HPD-FRAME-012",
                 "HPD-FRAME-010",
                 "HPD-FRAME-009",
                 "HPD-FRAME-022",
             ]),
-            MessageKind::WritePlc => r.extend(["HPD-FRAME-013", "HPD-FRAME-011", "HPD-FRAME-022"]),
+            MessageKind::WritePlc => r.extend(["HPD-FRAME-013", "HPD-FRAME-022"]),
             MessageKind::Broadcast => r.extend(["HPD-FRAME-019", "HPD-SERIAL-013"]),
             MessageKind::Response => r.push("HPD-SERIAL-001"),
         }

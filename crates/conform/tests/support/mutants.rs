@@ -36,6 +36,11 @@ pub enum Kind {
     /// Pr23 and Pr24 take a master's write.
     AlarmsWritable,
     PlcWritableWhileRunning,
+    /// A FIN after another instruction copies its input like a leading one.
+    FinAnywhere,
+    /// A write of Pb99 (the PLC run bit, written by every set-up that stops the PLC) is
+    /// taken but not acknowledged.
+    SilentSetupWrite,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -50,6 +55,8 @@ pub struct Mutant {
     held: Vec<u8>,
     /// Extra outputs the wrapper adds.
     extra: Vec<Output>,
+    /// `SilentSetupWrite`: the next acknowledge is dropped.
+    drop_ack: bool,
 }
 
 impl Mutant {
@@ -69,6 +76,7 @@ impl Mutant {
             rules: rules(),
             held: Vec::new(),
             extra: Vec::new(),
+            drop_ack: false,
         }
     }
 
@@ -227,6 +235,16 @@ impl Mutant {
                 self.force(now, par, &data);
                 return;
             }
+            (Kind::SilentSetupWrite, Some(Message::WriteParam { addr, par, .. }))
+                if addr == own
+                    && spec()
+                        .family(FamilyId::Hpd)
+                        .parameter("Pb99")
+                        .and_then(|p| p.address)
+                        == Some(u32::from(par)) =>
+            {
+                self.drop_ack = true;
+            }
             (Kind::PlcWritableWhileRunning, Some(Message::WritePlc { addr, .. }))
                 if addr == own =>
             {
@@ -263,6 +281,41 @@ impl Mutant {
             return;
         }
         self.inner.handle_rx(now, bytes);
+    }
+
+    /// `FinAnywhere`: while the PLC runs, every FIN that follows another instruction copies
+    /// its input (the k-th FIN input k, inverted when n bit 1 is set) into b40.y or b70.y.
+    fn late_fins(&mut self, now: Micros) {
+        let family = spec().family(FamilyId::Hpd);
+        let run = Target::parse(family, "b99.13").unwrap();
+        if self.inner.value(&run).unwrap_or(0) == 0 {
+            return;
+        }
+        let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec()).unwrap();
+        let Ok(program) = codec.decode_program(self.inner.plc_area()) else {
+            return;
+        };
+        let mut other_before = false;
+        let mut k = 0;
+        for (_, instr) in &program.instrs {
+            let drivespec_hpd::plc::Operands::Fin { y, n, .. } = instr.operands else {
+                other_before = true;
+                continue;
+            };
+            k += 1;
+            if !other_before {
+                continue;
+            }
+            let input = Target::parse(family, &format!("b90.{k}")).unwrap();
+            let level = self.inner.value(&input).unwrap_or(0) != 0;
+            let param = if n & 1 == 0 { 40 } else { 70 };
+            let Ok(out) = Target::parse(family, &format!("b{param}.{y}")) else {
+                continue;
+            };
+            let _ = self
+                .inner
+                .set_value(now, &out, i64::from(level != (n & 2 != 0)));
+        }
     }
 
     /// The deviation applied to what the drive sends.
@@ -330,16 +383,25 @@ impl SimDevice for Mutant {
     }
     fn advance(&mut self, now: Micros) {
         self.inner.advance(now);
+        if self.kind == Kind::FinAnywhere {
+            self.late_fins(now);
+        }
     }
     fn poll_output(&mut self) -> Option<Output> {
         if !self.extra.is_empty() {
             return Some(self.extra.remove(0));
         }
         match self.inner.poll_output()? {
-            Output::Transmit { at, bytes } => Some(Output::Transmit {
-                at,
-                bytes: self.tx(bytes),
-            }),
+            Output::Transmit { at, bytes } => {
+                if self.drop_ack && matches!(parse(&self.rules, &bytes), Ok(Message::Ack { .. })) {
+                    self.drop_ack = false;
+                    return self.poll_output();
+                }
+                Some(Output::Transmit {
+                    at,
+                    bytes: self.tx(bytes),
+                })
+            }
             o => Some(o),
         }
     }
@@ -473,6 +535,18 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::PlcWritableWhileRunning,
             breaks: v(&["HPD-BIT-99-13"]),
             must_fail: &["hpd/plc/upload-while-running"],
+        },
+        Case {
+            name: "FIN obeyed after other instructions",
+            kind: Kind::FinAnywhere,
+            breaks: v(&["HPD-PLC-032"]),
+            must_fail: &["hpd/plc/vector/plc-fin-after-other-inverted"],
+        },
+        Case {
+            name: "set-up write of Pb99 not answered",
+            kind: Kind::SilentSetupWrite,
+            breaks: v(&["HPD-FRAME-011"]),
+            must_fail: &["hpd/param/Pr33/min", "hpd/bit/b90.8/set"],
         },
         Case {
             name: "command bits stay set",
