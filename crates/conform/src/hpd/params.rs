@@ -99,7 +99,7 @@ fn open_value(g: &Gen, p: &Parameter) -> Option<((u32, i64, i64), String)> {
     let requirement = if unfixed {
         g.linked(p, |t| t.contains("read-only"))
     } else {
-        g.linked(p, |_| true)
+        g.linked(p, |t| t.contains("delivery value"))
     }
     .into_iter()
     .next()?;
