@@ -685,7 +685,6 @@ impl<'s> Gen<'s> {
     /// Read `slot`, whose value the manual does not fix, and report what the device shows:
     /// the value within `min..=max`, the bits under `mask` as the reference's;
     /// `requirement` is the point the finding belongs to.
-    #[allow(clippy::too_many_arguments)]
     pub(crate) fn read_open(
         &mut self,
         cb: &mut CaseB,
