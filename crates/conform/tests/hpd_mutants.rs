@@ -94,3 +94,60 @@ fn a_failure_names_the_broken_requirement_first() {
     };
     insta::assert_snapshot!(f.headline().join("\n"));
 }
+
+/// Runs the case `id` of the HPD suite against `kind`.
+fn run_one(kind: support::mutants::Kind, id: &str) -> drivespec_conform::case::CaseRun {
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let link = SimLink::new("mutant", Box::new(Mutant::new(kind)));
+    let mut session = suite.session(Box::new(link));
+    let i = suite.cases().iter().position(|c| c.id == id).unwrap();
+    session.run(i)
+}
+
+/// A set-up write the drive takes without answering fails at that step, naming the
+/// acknowledge rule (manual 4.1 CMD 1) first.
+#[test]
+fn a_missing_answer_to_a_set_up_write_fails_naming_the_acknowledge_rule() {
+    let run = run_one(
+        support::mutants::Kind::SilentSetupWrite,
+        "hpd/param/Pr33/min",
+    );
+    let Outcome::Fail(f) = run.outcome else {
+        panic!("a silent set-up write passes");
+    };
+    let step = &run.evidence[f.step.unwrap()];
+    assert_eq!(step.role, drivespec_conform::case::Role::Setup, "{f:?}");
+    assert_eq!(f.requirements[0].id, "HPD-FRAME-011", "{f:?}");
+}
+
+/// Clean-up writes back the value the device had, not the reference's: a drive delivered
+/// with Pr15 = 20 (as 3.3 prints it, HPD-ERRATUM-005) gets 20 back after a Pr15 case.
+#[test]
+fn clean_up_writes_back_the_devices_own_value() {
+    let family = spec().family(drivespec_spec::FamilyId::Hpd);
+    let pr15 = drivespec_hpd::params::Target::parse(family, "Pr15").unwrap();
+    let mut drive = drivespec_hpd::model::Drive::new(
+        spec(),
+        drivespec_hpd::model::DriveConfig::commissioned(0),
+    )
+    .unwrap();
+    drive.set_value(0, &pr15, 20).unwrap();
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let link = SimLink::new("Pr15 = 20", Box::new(drive));
+    let mut session = suite.session(Box::new(link));
+    let i = suite
+        .cases()
+        .iter()
+        .position(|c| c.id == "hpd/param/Pr15/min")
+        .unwrap();
+    let run = session.run(i);
+    assert!(matches!(run.outcome, Outcome::Pass), "{:?}", run.outcome);
+    let back: Vec<&str> = run
+        .evidence
+        .iter()
+        .filter(|r| r.action.starts_with("write back the Pr15"))
+        .filter_map(|r| r.sent.as_deref())
+        .collect();
+    // CMD 5 to drive 0 (0xA0), LUN 2, PAR 0x46, data 20 = 14 00.
+    assert_eq!(back, ["7E A0 02 46 14 00 FC"]);
+}

@@ -21,6 +21,21 @@ pub enum Compare {
     Mask(u32),
     /// The same frame header; the data as a value within ± the tolerance (timers counting).
     Near(i64),
+    /// A value the manual does not fix (an example value, a silent point): the same frame
+    /// header, the data bits under `mask` as the reference's, and the data as a value
+    /// within `min..=max` (read signed when `min` is negative); the value seen is reported.
+    Open {
+        /// Data bits compared with the reference (little-endian over the data bytes).
+        mask: u32,
+        /// Lowest value allowed.
+        min: i64,
+        /// Highest value allowed.
+        max: i64,
+    },
+    /// The same frame header and the data the device answered to the case's `save` of the
+    /// same parameter (a read-only parameter kept its value); the reference's data is not
+    /// compared.
+    Unchanged,
 }
 
 /// One HPD step (key `do`). Steps without keys are written `Name {}` so that a key given
@@ -66,6 +81,27 @@ pub enum Step {
     },
     /// Sets the transport's bit rate to the one the reference now uses (after b42.3).
     BitRate {},
+    /// Reads `lun` bytes at serial address `par` from the drive at `addr` (and the
+    /// reference) and keeps the device's data for a later `restore` or `unchanged` compare.
+    Save {
+        /// Drive address.
+        addr: u8,
+        /// Serial address of the parameter.
+        par: u8,
+        /// Its length in bytes.
+        lun: u8,
+    },
+    /// Writes the data the case's `save` of `par` read from the device back to the drive at
+    /// `addr` and to the reference (the device's own value, manual 4.1 CMD 5); nothing when
+    /// no `save` read it.
+    Restore {
+        /// Drive address.
+        addr: u8,
+        /// Serial address of the parameter.
+        par: u8,
+        /// Its length in bytes.
+        lun: u8,
+    },
 }
 
 impl Step {
@@ -80,6 +116,8 @@ impl Step {
             Step::PowerCycle {} => "power-cycle",
             Step::Inputs { .. } => "inputs",
             Step::BitRate {} => "bit-rate",
+            Step::Save { .. } => "save",
+            Step::Restore { .. } => "restore",
         }
     }
 
@@ -200,6 +238,30 @@ mod tests {
             Step::PowerCycle {},
             Step::Inputs { value: 0xFFFF },
             Step::BitRate {},
+            Step::Save {
+                addr: 0,
+                par: 0x46,
+                lun: 2,
+            },
+            Step::Restore {
+                addr: 1,
+                par: 0x46,
+                lun: 2,
+            },
+            Step::Exchange {
+                bytes: vec![0x7E],
+                compare: Compare::Open {
+                    mask: 0xFF00,
+                    min: -20,
+                    max: 20,
+                },
+                silence_ok: false,
+            },
+            Step::Exchange {
+                bytes: vec![0x7E],
+                compare: Compare::Unchanged,
+                silence_ok: false,
+            },
         ];
         for s in &steps {
             let text = toml::to_string(s).unwrap();

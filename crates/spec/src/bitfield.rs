@@ -204,6 +204,8 @@ pub(crate) fn rule_requirements(bitfields: &[Bitfield]) -> Vec<Requirement> {
                         .unwrap_or_else(|| format!("{} bit {}", b.section(), bit.bit)),
                     params: rule.params.clone(),
                     note: rule.note.clone(),
+                    observable: true,
+                    reason: None,
                     file: b.file.clone(),
                 });
             }

@@ -143,6 +143,10 @@ pub struct ModeMeaning {
     /// Default in those modes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub default: Option<i64>,
+    /// Access in those modes, where it differs from the parameter's (Pr55 is read-only in
+    /// modes 2, 8 and 10, manual 3.6.2, 3.6.3, 3.6.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub access: Option<Access>,
     /// One line.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub description: Option<String>,

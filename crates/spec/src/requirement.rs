@@ -43,7 +43,25 @@ pub struct Requirement {
     /// Remark.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// Whether a check over the interface can observe it; `false` for safety instructions
+    /// and motor physics that no message or cyclic image shows.
+    #[serde(default = "observable_default", skip_serializing_if = "is_observable")]
+    pub observable: bool,
+    /// Why the requirement cannot be observed over the interface; given exactly when
+    /// `observable` is `false`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
     /// File the record was loaded from.
     #[serde(skip)]
     pub file: String,
+}
+
+/// A requirement is observable unless its record says otherwise.
+fn observable_default() -> bool {
+    true
+}
+
+/// Whether `observable` has its default value and is left out when written.
+fn is_observable(observable: &bool) -> bool {
+    *observable
 }

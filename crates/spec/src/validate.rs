@@ -432,6 +432,17 @@ impl Validator<'_> {
                     self.dangling(&r.file, rec.clone(), "parameter", p);
                 }
             }
+            let message = match (r.observable, r.reason.as_deref().map(str::trim)) {
+                (false, None | Some("")) => {
+                    Some("`observable = false` needs a `reason` saying why no check can see it")
+                }
+                (true, Some(_)) => Some("a `reason` is given only with `observable = false`"),
+                _ => None,
+            };
+            if let Some(message) = message {
+                let message = message.to_owned();
+                self.push(&r.file, rec.clone(), ProblemKind::Invalid { message });
+            }
         }
     }
 

@@ -385,6 +385,39 @@ fn requirement_level_is_checked() {
 }
 
 #[test]
+fn unobservable_requirement_with_its_reason_is_valid() {
+    let req =
+        format!("{REQ}observable = false\nreason = \"the motor's heating is not on the bus\"\n");
+    assert_eq!(
+        problems_with("psd4xx/test.toml", &req),
+        Vec::<String>::new()
+    );
+}
+
+#[test]
+fn unobservable_requirement_needs_a_reason() {
+    let p = one_problem(&format!("{REQ}observable = false\n"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: requirement "PSD-PAR-044": `observable = false` needs a `reason` saying why no check can see it"#
+    );
+    let p = one_problem(&format!("{REQ}observable = false\nreason = \" \"\n"));
+    assert!(
+        p.ends_with("needs a `reason` saying why no check can see it"),
+        "{p}"
+    );
+}
+
+#[test]
+fn reason_on_an_observable_requirement_is_rejected() {
+    let p = one_problem(&format!("{REQ}reason = \"seen on the bus\"\n"));
+    assert_eq!(
+        p,
+        r#"psd4xx/test.toml: requirement "PSD-PAR-044": a `reason` is given only with `observable = false`"#
+    );
+}
+
+#[test]
 fn duplicate_requirement_across_files_names_the_first_file() {
     let mut files = skeleton();
     files.set("psd4xx/a.toml", REQ);

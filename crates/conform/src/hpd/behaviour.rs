@@ -100,8 +100,15 @@ fn broadcast(g: &mut Gen) {
         &["HPD-SERIAL-013", "HPD-PAR-037"],
     );
     let v = sign_for(ro, g.base(ro) ^ 1, g.family);
+    g.save(&mut cb, ro, "Pr25");
     bcast(g, &mut cb, ro, v, "Pr25");
-    g.read(&mut cb, Role::Check, ro, Compare::Exact, "Pr25 (unchanged)");
+    g.read(
+        &mut cb,
+        Role::Check,
+        ro,
+        Compare::Unchanged,
+        "Pr25 (unchanged)",
+    );
     g.push(cb);
 
     let other = other_address(g);

@@ -31,3 +31,9 @@ pub(crate) const USER_FLAG: &str = "b90.8";
 
 /// Bit-rule trigger of command bits (bits.toml).
 pub(crate) const TRIGGER_COMMAND: &str = "command-executed";
+/// Bit-rule trigger of the end of the wiring test (bits.toml b70.3): manual 3.6.3 gives the
+/// test no duration, so a read right after the start may show b70.3 either way.
+pub(crate) const TRIGGER_TEST_FINISHED: &str = "wiring-test-finished";
+/// A delivery value the manual prints two ways (3.3 Pr15 default 20, 3.2 "±20 rpm",
+/// HPD-ERRATUM-005): a read at the start shows one of them.
+pub(crate) const TWO_WAY_DEFAULT: &str = "Pr15";

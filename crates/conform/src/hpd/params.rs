@@ -49,7 +49,16 @@ fn param_cases(g: &mut Gen, p: &Parameter) {
     if p.access == drivespec_spec::Access::R {
         cb.reqs(g.linked(p, |t| t.contains("read-only")));
     }
-    g.read(&mut cb, Role::Check, slot, cmp, &p.id);
+    match open_value(g, p) {
+        Some((bounds, requirement)) => {
+            cb.description = format!(
+                "{}; the manual does not fix its value: {}..={} accepted and reported",
+                cb.description, bounds.1, bounds.2
+            );
+            g.read_open(&mut cb, slot, bounds, &requirement, &p.id);
+        }
+        None => g.read(&mut cb, Role::Check, slot, cmp, &p.id),
+    }
     g.push(cb);
 
     if !p.access.writable() {
@@ -62,11 +71,49 @@ fn param_cases(g: &mut Gen, p: &Parameter) {
     edges(g, p, slot, None);
     let modes = Gen::ranged_modes(p);
     for m in modes {
-        edges(g, p, slot, Some(m));
+        let read_only = p
+            .modes
+            .iter()
+            .any(|e| e.modes.contains(&m) && e.access.is_some_and(|a| !a.writable()));
+        if read_only {
+            refused_in_mode(g, p, slot, m);
+        } else {
+            edges(g, p, slot, Some(m));
+        }
     }
 }
 
-/// A write to a read-only parameter is acknowledged and changes nothing.
+/// The bounds of a read whose value the manual does not fix, with the requirement the
+/// point belongs to: a read-only parameter the drive does not change by itself and whose value
+/// the manual does not give (Pr25, the software version code: 3.3 names no code), and a
+/// delivery value the manual prints two ways (names::TWO_WAY_DEFAULT).
+fn open_value(g: &Gen, p: &Parameter) -> Option<((u32, i64, i64), String)> {
+    let unfixed = p.access == drivespec_spec::Access::R && !p.live && p.default.is_none();
+    if !unfixed && p.id != names::TWO_WAY_DEFAULT {
+        return None;
+    }
+    let (min, max) = match g.range_in(p, None) {
+        Some(r) => (r.min()?, r.max()?),
+        None => p.data_type.bounds()?,
+    };
+    let requirement = if unfixed {
+        g.linked(p, |t| t.contains("read-only"))
+    } else {
+        g.linked(p, |t| t.contains("delivery value"))
+    }
+    .into_iter()
+    .next()?;
+    Some(((0, min, max), requirement))
+}
+
+/// Whether the drive holds `p` at the value a case read before: not a value it changes by
+/// itself, or an alarm code while no case raises an alarm (manual 3.3 Pr23, Pr24).
+fn holds_still(p: &Parameter) -> bool {
+    !p.live || names::ALARMS.contains(&p.id.as_str())
+}
+
+/// A write to a read-only parameter is acknowledged and changes nothing: the value read
+/// before the write is read after it (where the drive does not change it by itself).
 fn refused(g: &mut Gen, p: &Parameter, slot: Slot, cmp: Compare) {
     let base = g.base(slot);
     let value = sign_for(slot, base ^ 1, g.family);
@@ -75,7 +122,14 @@ fn refused(g: &mut Gen, p: &Parameter, slot: Slot, cmp: Compare) {
         format!("{} is read-only: a write of {value} is not taken", p.id),
         &["HPD-SERIAL-015"],
     );
-    cb.reqs(g.linked(p, |t| t.contains("read-only")));
+    let read_only = g.linked(p, |t| t.contains("read-only"));
+    cb.reqs(read_only.iter().cloned());
+    let cmp = if holds_still(p) {
+        g.save(&mut cb, slot, &p.id);
+        Compare::Unchanged
+    } else {
+        cmp
+    };
     g.write(&mut cb, Role::Check, slot, value, &p.id);
     g.read(
         &mut cb,
@@ -84,7 +138,50 @@ fn refused(g: &mut Gen, p: &Parameter, slot: Slot, cmp: Compare) {
         cmp,
         &format!("{} (unchanged)", p.id),
     );
+    if let (Some(step), Some(r)) = (cb.steps.last_mut(), read_only.first()) {
+        step.requirements.insert(0, r.clone());
+    }
     g.push(cb);
+}
+
+/// A write to a parameter that is read-only in operating mode `mode` (Pr55 in mode 2, manual
+/// 3.6.2) is not taken: the value read in that mode before the write is read after it.
+fn refused_in_mode(g: &mut Gen, p: &Parameter, slot: Slot, mode: u32) {
+    let (Some(range), Some(ms)) = (g.range_in(p, Some(mode)), g.slot_of(names::OPERATING_MODE))
+    else {
+        return;
+    };
+    let mode_text = format!("mode {mode}");
+    let read_only = g.linked(p, |t| t.contains("read-only") && t.contains(&mode_text));
+    for (name, value) in [("min", range.min()), ("max", range.max())] {
+        let Some(value) = value else { continue };
+        let mut cb = CaseB::new(
+            format!("hpd/param/{}/mode-{mode}/{name}", p.id),
+            format!(
+                "{} is read-only in operating mode {mode}: a write of {value}, the {name} of its range {range}, is not taken",
+                p.id
+            ),
+            &["HPD-SERIAL-015", "HPD-MODE-005"],
+        );
+        cb.reqs(read_only.iter().cloned());
+        g.stop_plc(&mut cb);
+        g.write(&mut cb, Role::Setup, ms, i64::from(mode), "Pr31");
+        g.save(&mut cb, slot, &p.id);
+        g.write(&mut cb, Role::Check, slot, value, &p.id);
+        g.read(
+            &mut cb,
+            Role::Check,
+            slot,
+            Compare::Unchanged,
+            &format!("{} (unchanged)", p.id),
+        );
+        if let (Some(step), Some(r)) = (cb.steps.last_mut(), read_only.first()) {
+            step.requirements.insert(0, r.clone());
+        }
+        g.restore(&mut cb, ms, "Pr31");
+        g.restore_pb99(&mut cb);
+        g.push(cb);
+    }
 }
 
 /// Range edges and one beyond, in operating mode `mode` (None: the start mode).
@@ -462,7 +559,24 @@ fn one_bit(
         Compare::Mask(m) => Compare::Mask(m | bit_in_value(slot, r.at)),
         c => c,
     };
-    g.read(&mut cb, Role::Check, slot, cmp, &p.id);
+    let ends_by_itself = b
+        .rules
+        .iter()
+        .find(|rule| rule.trigger == names::TRIGGER_TEST_FINISHED);
+    match (ends_by_itself, value, p.data_type.bounds()) {
+        (Some(rule), true, Some((lo, hi))) => {
+            // The drive clears the bit when the test ends, after a time the manual does not
+            // give: the bit is read either way and reported.
+            let all = match cmp {
+                Compare::Mask(m) => m,
+                _ => u32::MAX,
+            };
+            let mask = all & !bit_in_value(slot, r.at);
+            let rule_req = rule.requirement.clone();
+            g.read_open(&mut cb, slot, (mask, lo, hi), &rule_req, &p.id);
+        }
+        _ => g.read(&mut cb, Role::Check, slot, cmp, &p.id),
+    }
     g.restore(&mut cb, slot, &p.id);
     if let (Some(_), Some(ms)) = (mode, mode_slot) {
         g.restore(&mut cb, ms, "Pr31");

@@ -11,14 +11,17 @@
 
 use super::step::{Action, Compare, HpdCase, Step};
 use super::HpdSuite;
-use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::case::{
+    Answer, CaseInfo, CaseRun, Failure, Finding, Outcome, Record, RequirementRef, Role,
+};
 use crate::link::{concat, Chunk, Link, LinkError, Micros, Recovered};
 use crate::suite::Session;
 use drivespec_hpd::explain::explain;
 use drivespec_hpd::model::{Drive, Output};
 use drivespec_hpd::params::Target;
-use drivespec_hpd::{LineDecoder, LineEvent, Message};
+use drivespec_hpd::{Data, LineDecoder, LineEvent, Message};
 use drivespec_spec::hex::to_hex;
+use std::collections::BTreeMap;
 
 /// Most bytes of one answer kept whole in the evidence; a longer one keeps its start and its
 /// last 64 bytes.
@@ -33,6 +36,8 @@ pub struct HpdSession<'a, 's> {
     offset: Micros,
     /// Extra time allowed for answers (µs).
     slack: Micros,
+    /// The device's values the case's `save` steps read, by (serial address, length).
+    saved: BTreeMap<(u8, u8), Data>,
 }
 
 /// A judged step's (match, explanation), nothing to judge, or a transport error with the
@@ -56,6 +61,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             oracle: suite.baseline.clone(),
             offset: 0,
             slack,
+            saved: BTreeMap::new(),
         }
     }
 
@@ -375,7 +381,7 @@ fn matches(rules: &drivespec_hpd::FrameRules, compare: Compare, exp: &[u8], got:
     if exp == got {
         return true;
     }
-    let (Compare::Mask(_) | Compare::Near(_)) = compare else {
+    let (Compare::Mask(_) | Compare::Near(_) | Compare::Open { .. }) = compare else {
         return false;
     };
     let (Ok(a), Ok(b)) = (
@@ -401,7 +407,11 @@ fn matches(rules: &drivespec_hpd::FrameRules, compare: Compare, exp: &[u8], got:
             Compare::Near(tolerance) => {
                 (i64::from(ad.unsigned()) - i64::from(bd.unsigned())).abs() <= tolerance
             }
-            Compare::Exact => false,
+            Compare::Open { mask, min, max } => {
+                ad.unsigned() & mask == bd.unsigned() & mask
+                    && (min..=max).contains(&value_of(&bd, min < 0))
+            }
+            Compare::Exact | Compare::Unchanged => false,
         },
         _ => false,
     }
@@ -480,6 +490,49 @@ impl HpdSession<'_, '_> {
         Ok(done)
     }
 
+    /// A `save` step: reads the parameter from the device and the reference and keeps the
+    /// device's data; judged as a read whose value the manual does not fix.
+    fn save(&mut self, addr: u8, par: u8, lun: u8, rec: &mut Record) -> StepResult {
+        let msg = Message::ReadParam { addr, lun, par };
+        let Ok(bytes) = msg.to_bytes(&self.suite.rules) else {
+            rec.note = Some("nothing saved: not a read message".to_owned());
+            return Ok(None);
+        };
+        rec.sent = Some(to_hex(&bytes));
+        rec.sent_text = Some(self.words(&bytes, None));
+        let obs = self.exchange(&bytes)?;
+        let got = concat(&obs.got);
+        let ea = self.answer(&obs.expected, obs.t0, Some(&msg));
+        let ga = self.answer(&obs.got, obs.t0, Some(&msg));
+        let all = Compare::Open {
+            mask: 0,
+            min: 0,
+            max: i64::from(u32::MAX),
+        };
+        let ok = matches(&self.suite.rules, all, &concat(&obs.expected), &got);
+        if let (true, Some((_, data))) = (ok, response(&self.suite.rules, &got)) {
+            self.saved.insert((par, lun), data);
+        }
+        let why = format!(
+            "expected a response of {lun} byte(s) at {par:#04x} like {}, got {}",
+            show(&ea),
+            show(&ga)
+        );
+        rec.note = Some("the device's value is kept to be written back".to_owned());
+        rec.expected = Some(ea);
+        rec.got = Some(ga);
+        Ok(Some((ok, why)))
+    }
+
+    /// Whether `got` is a response carrying the data a `save` of the same parameter read.
+    fn unchanged(&self, got: &[u8]) -> bool {
+        response(&self.suite.rules, got).is_some_and(|(par, data)| {
+            self.saved
+                .get(&(par, data.len()))
+                .is_some_and(|kept| *kept == data)
+        })
+    }
+
     /// Runs `case` (described by `info`) as [`Session::run`] runs a suite case, judged step
     /// by step against the reference; `from_start`: reset first on transports that can.
     pub(crate) fn run_case(
@@ -523,6 +576,8 @@ impl HpdSession<'_, '_> {
                 }
             }
         }
+        self.saved.clear();
+        let mut findings: Vec<Finding> = Vec::new();
         let mut evidence: Vec<Record> = Vec::new();
         let mut failure: Option<Failure> = None;
         let mut checked: Vec<String> = Vec::new();
@@ -566,8 +621,10 @@ impl HpdSession<'_, '_> {
                             let got = concat(&obs.got);
                             let ea = self.answer(&obs.expected, obs.t0, request.as_ref());
                             let ga = self.answer(&obs.got, obs.t0, request.as_ref());
-                            let mut ok = matches(&suite.rules, *compare, &exp, &got)
-                                || (*silence_ok && got.is_empty());
+                            let mut ok = match compare {
+                                Compare::Unchanged => self.unchanged(&got),
+                                _ => matches(&suite.rules, *compare, &exp, &got),
+                            } || (*silence_ok && got.is_empty());
                             let mut why = format!("expected {}, got {}", show(&ea), show(&ga));
                             if let (true, Some(ed), Some(gd)) =
                                 (ok && !got.is_empty(), ea.delay_us, ga.delay_us)
@@ -592,7 +649,20 @@ impl HpdSession<'_, '_> {
                                 Compare::Exact => None,
                                 Compare::Mask(m) => Some(format!("data compared under mask {m:#06x} (bits the drive sets itself are not compared)")),
                                 Compare::Near(tolerance) => Some(format!("data compared within ±{tolerance}")),
+                                Compare::Open { mask, min, max } => Some(format!("the manual does not fix the value: {min}..={max} accepted, bits {mask:#06x} compared")),
+                                Compare::Unchanged => Some("data compared with the value read before the write".to_owned()),
                             };
+                            if let (true, Compare::Open { .. }, Some(requirement)) =
+                                (ok && judged, compare, step.requirements.first())
+                            {
+                                findings.push(Finding::Open {
+                                    requirement: requirement.clone(),
+                                    text: format!(
+                                        "{}: the device: {}; the reference: {}",
+                                        step.text, ga.text, ea.text
+                                    ),
+                                });
+                            }
                             if *silence_ok {
                                 rec.note = Some(
                                     "silence is also accepted (vector result: acceptable)"
@@ -668,6 +738,48 @@ impl HpdSession<'_, '_> {
                     match self.link.set_bit_rate(bps) {
                         Ok(()) => Ok(None),
                         Err(e) => Err((e, Vec::new())),
+                    }
+                }
+                Action::Save { addr, par, lun } => self.save(*addr, *par, *lun, &mut rec),
+                Action::Restore { addr, par, lun } => {
+                    match self.saved.get(&(*par, *lun)).cloned() {
+                        Some(data) => {
+                            let msg = Message::WriteParam {
+                                addr: *addr,
+                                par: *par,
+                                data,
+                            };
+                            match msg.to_bytes(&suite.rules) {
+                                Ok(bytes) => {
+                                    rec.sent = Some(to_hex(&bytes));
+                                    rec.sent_text = Some(self.words(&bytes, None));
+                                    match self.exchange(&bytes) {
+                                        Ok(obs) => {
+                                            let ea = self.answer(&obs.expected, obs.t0, None);
+                                            let ga = self.answer(&obs.got, obs.t0, None);
+                                            let ok = ea.hex == ga.hex;
+                                            let why = format!(
+                                                "expected {}, got {}",
+                                                show(&ea),
+                                                show(&ga)
+                                            );
+                                            rec.expected = Some(ea);
+                                            rec.got = Some(ga);
+                                            Ok(Some((ok, why)))
+                                        }
+                                        Err(e) => Err(e),
+                                    }
+                                }
+                                Err(e) => {
+                                    rec.note = Some(format!("nothing restored: {e}"));
+                                    Ok(None)
+                                }
+                            }
+                        }
+                        None => {
+                            rec.note = Some("nothing restored: no value was saved".to_owned());
+                            Ok(None)
+                        }
                     }
                 }
                 Action::Inputs { value } => match self.link.set_inputs(*value) {
@@ -759,8 +871,11 @@ impl HpdSession<'_, '_> {
             self.resync(case);
         }
         let elapsed_us = self.link.now().saturating_sub(start);
+        if failure.is_some() {
+            findings.clear();
+        }
         CaseRun {
-            findings: Vec::new(),
+            findings,
             checked,
             outcome: match failure {
                 Some(f) => Outcome::Fail(f),
@@ -777,5 +892,22 @@ fn show(a: &Answer) -> String {
         "silence".to_owned()
     } else {
         format!("{} ({})", a.hex, a.text)
+    }
+}
+
+/// The data as a number: signed over its length when `signed`.
+fn value_of(data: &Data, signed: bool) -> i64 {
+    if !signed {
+        return i64::from(data.unsigned());
+    }
+    let shift = 32 - 8 * u32::from(data.len().clamp(1, 4));
+    i64::from((data.signed() << shift) >> shift)
+}
+
+/// The response `bytes` hold, if they are one.
+fn response(rules: &drivespec_hpd::FrameRules, bytes: &[u8]) -> Option<(u8, Data)> {
+    match drivespec_hpd::parse(rules, bytes) {
+        Ok(Message::Response { par, data, .. }) => Some((par, data)),
+        _ => None,
     }
 }

@@ -33,7 +33,14 @@ pub enum Kind {
     BigEndian,
     NoStuffing,
     ReadOnlyWritable,
+    /// Pr23 and Pr24 take a master's write.
+    AlarmsWritable,
     PlcWritableWhileRunning,
+    /// A FIN after another instruction copies its input like a leading one.
+    FinAnywhere,
+    /// A write of Pb99 (the PLC run bit, written by every set-up that stops the PLC) is
+    /// taken but not acknowledged.
+    SilentSetupWrite,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -48,6 +55,8 @@ pub struct Mutant {
     held: Vec<u8>,
     /// Extra outputs the wrapper adds.
     extra: Vec<Output>,
+    /// `SilentSetupWrite`: the next acknowledge is dropped.
+    drop_ack: bool,
 }
 
 impl Mutant {
@@ -67,6 +76,7 @@ impl Mutant {
             rules: rules(),
             held: Vec::new(),
             extra: Vec::new(),
+            drop_ack: false,
         }
     }
 
@@ -82,16 +92,29 @@ impl Mutant {
         }
     }
 
-    fn value_in_range(&self, p: &drivespec_spec::Parameter, v: i64) -> bool {
+    fn mode(&self) -> u32 {
         let family = spec().family(FamilyId::Hpd);
-        let mode = family
+        family
             .parameter("Pr31")
             .and_then(|m| self.inner.value(&Target::Param(m)).ok())
-            .unwrap_or(0);
+            .unwrap_or(0) as u32
+    }
+
+    /// Whether `p` is read-only in the operating mode in force (Pr55 in mode 2).
+    fn read_only_in_mode(&self, p: &drivespec_spec::Parameter) -> bool {
+        let mode = self.mode();
+        p.modes
+            .iter()
+            .any(|e| e.modes.contains(&mode) && e.access.is_some_and(|a| !a.writable()))
+    }
+
+    fn value_in_range(&self, p: &drivespec_spec::Parameter, v: i64) -> bool {
+        let family = spec().family(FamilyId::Hpd);
+        let mode = self.mode();
         let range = p
             .modes
             .iter()
-            .find(|e| e.modes.contains(&(mode as u32)))
+            .find(|e| e.modes.contains(&mode))
             .and_then(|e| e.range.clone())
             .or_else(|| family.resolve(p, None).range);
         range.is_none_or(|r| r.contains(v))
@@ -113,7 +136,8 @@ impl Mutant {
         let v = t.value(data);
         let take = match self.kind {
             Kind::IgnoresRanges => p.access.writable() && !self.value_in_range(p, v),
-            Kind::ReadOnlyWritable => !p.access.writable(),
+            Kind::ReadOnlyWritable => !p.access.writable() || self.read_only_in_mode(p),
+            Kind::AlarmsWritable => ["Pr23", "Pr24"].contains(&p.id.as_str()),
             _ => false,
         };
         if take {
@@ -196,7 +220,7 @@ impl Mutant {
                 return;
             }
             (
-                Kind::IgnoresRanges | Kind::ReadOnlyWritable,
+                Kind::IgnoresRanges | Kind::ReadOnlyWritable | Kind::AlarmsWritable,
                 Some(Message::WriteParam { addr, par, data }),
             ) if addr == own => {
                 self.inner.handle_rx(now, bytes);
@@ -210,6 +234,16 @@ impl Mutant {
                 self.inner.handle_rx(now, bytes);
                 self.force(now, par, &data);
                 return;
+            }
+            (Kind::SilentSetupWrite, Some(Message::WriteParam { addr, par, .. }))
+                if addr == own
+                    && spec()
+                        .family(FamilyId::Hpd)
+                        .parameter("Pb99")
+                        .and_then(|p| p.address)
+                        == Some(u32::from(par)) =>
+            {
+                self.drop_ack = true;
             }
             (Kind::PlcWritableWhileRunning, Some(Message::WritePlc { addr, .. }))
                 if addr == own =>
@@ -247,6 +281,41 @@ impl Mutant {
             return;
         }
         self.inner.handle_rx(now, bytes);
+    }
+
+    /// `FinAnywhere`: while the PLC runs, every FIN that follows another instruction copies
+    /// its input (the k-th FIN input k, inverted when n bit 1 is set) into b40.y or b70.y.
+    fn late_fins(&mut self, now: Micros) {
+        let family = spec().family(FamilyId::Hpd);
+        let run = Target::parse(family, "b99.13").unwrap();
+        if self.inner.value(&run).unwrap_or(0) == 0 {
+            return;
+        }
+        let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec()).unwrap();
+        let Ok(program) = codec.decode_program(self.inner.plc_area()) else {
+            return;
+        };
+        let mut other_before = false;
+        let mut k = 0;
+        for (_, instr) in &program.instrs {
+            let drivespec_hpd::plc::Operands::Fin { y, n, .. } = instr.operands else {
+                other_before = true;
+                continue;
+            };
+            k += 1;
+            if !other_before {
+                continue;
+            }
+            let input = Target::parse(family, &format!("b90.{k}")).unwrap();
+            let level = self.inner.value(&input).unwrap_or(0) != 0;
+            let param = if n & 1 == 0 { 40 } else { 70 };
+            let Ok(out) = Target::parse(family, &format!("b{param}.{y}")) else {
+                continue;
+            };
+            let _ = self
+                .inner
+                .set_value(now, &out, i64::from(level != (n & 2 != 0)));
+        }
     }
 
     /// The deviation applied to what the drive sends.
@@ -314,16 +383,25 @@ impl SimDevice for Mutant {
     }
     fn advance(&mut self, now: Micros) {
         self.inner.advance(now);
+        if self.kind == Kind::FinAnywhere {
+            self.late_fins(now);
+        }
     }
     fn poll_output(&mut self) -> Option<Output> {
         if !self.extra.is_empty() {
             return Some(self.extra.remove(0));
         }
         match self.inner.poll_output()? {
-            Output::Transmit { at, bytes } => Some(Output::Transmit {
-                at,
-                bytes: self.tx(bytes),
-            }),
+            Output::Transmit { at, bytes } => {
+                if self.drop_ack && matches!(parse(&self.rules, &bytes), Ok(Message::Ack { .. })) {
+                    self.drop_ack = false;
+                    return self.poll_output();
+                }
+                Some(Output::Transmit {
+                    at,
+                    bytes: self.tx(bytes),
+                })
+            }
             o => Some(o),
         }
     }
@@ -437,13 +515,38 @@ pub fn mutants() -> Vec<Case> {
             name: "read-only parameters writable",
             kind: Kind::ReadOnlyWritable,
             breaks: read_only,
-            must_fail: &["hpd/param/Pr25/write-refused"],
+            must_fail: &[
+                "hpd/param/Pr25/write-refused",
+                "hpd/param/Pr23/write-refused",
+                "hpd/param/Pr55/mode-2/max",
+            ],
+        },
+        Case {
+            name: "alarm codes writable",
+            kind: Kind::AlarmsWritable,
+            breaks: v(&["HPD-ALARM-010"]),
+            must_fail: &[
+                "hpd/param/Pr23/write-refused",
+                "hpd/param/Pr24/write-refused",
+            ],
         },
         Case {
             name: "PLC writable while running",
             kind: Kind::PlcWritableWhileRunning,
             breaks: v(&["HPD-BIT-99-13"]),
             must_fail: &["hpd/plc/upload-while-running"],
+        },
+        Case {
+            name: "FIN obeyed after other instructions",
+            kind: Kind::FinAnywhere,
+            breaks: v(&["HPD-PLC-032"]),
+            must_fail: &["hpd/plc/vector/plc-fin-after-other-inverted"],
+        },
+        Case {
+            name: "set-up write of Pb99 not answered",
+            kind: Kind::SilentSetupWrite,
+            breaks: v(&["HPD-FRAME-011"]),
+            must_fail: &["hpd/param/Pr33/min", "hpd/bit/b90.8/set"],
         },
         Case {
             name: "command bits stay set",

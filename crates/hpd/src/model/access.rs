@@ -95,6 +95,10 @@ impl Drive {
         if !p.writable {
             return None;
         }
+        // HPD-MODE-2-003, HPD-MODE-10-005: a parameter read-only in the mode in force.
+        if p.mode(self.mode()).is_some_and(|m| !m.writable) {
+            return None;
+        }
         // HPD-BIT-99-7, HPD-BIT-99-7-SELF: with security on, only b99.7 itself can change.
         if self.secured() {
             let sec = layout.named.security;

@@ -19,6 +19,8 @@ pub(super) struct ModeEntry {
     pub(super) modes: Vec<u32>,
     pub(super) range: Option<Ranges>,
     pub(super) default: Option<i64>,
+    /// Writable in these modes (HPD-MODE-2-003: Pr55 is read-only in mode 2).
+    pub(super) writable: bool,
 }
 
 /// One parameter with a serial slot (manual 4.2).
@@ -466,6 +468,7 @@ fn resolve_param(family: &Family, p: &Parameter) -> Option<Param> {
                 modes: m.modes.clone(),
                 range: m.range.clone(),
                 default: m.default,
+                writable: m.access.is_none_or(|a| a.writable()),
             })
             .collect(),
     })
