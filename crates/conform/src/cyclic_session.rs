@@ -173,6 +173,19 @@ pub(crate) trait CyclicFamily<'s> {
     ) -> Op<Self::Output>;
     /// Whether an input image answers `action` (ends an [`Op::Send`] once both sides have).
     fn answered(&self, action: &Self::Action, reference: &Self::Input) -> bool;
+    /// The device's input of cycle `at` as it is judged against the reference's (`device` and
+    /// `reference` hold every cycle's input, None where none came): a family may put the
+    /// reference's value in place of a value the device read itself at the moment of a
+    /// request where the manual bounds that value by the device's own data. By default the
+    /// input as it came.
+    fn judged(
+        &self,
+        device: &[Option<Self::Input>],
+        _reference: &[Self::Input],
+        at: usize,
+    ) -> Option<Self::Input> {
+        device.get(at).copied().flatten()
+    }
 }
 
 /// The peer of the device under test `dut`; `sim` is the reference server of `model`, built
@@ -666,6 +679,17 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
 
     /// Judges the cycles under `tol`; marks the records and sets the first failure.
     fn judge(&self, run: &mut Run<'_, 's, F::Input, F::Output>, tol: Tolerance) {
+        let device: Vec<Option<F::Input>> = run
+            .cycles
+            .iter()
+            .map(|c| c.dut.as_ref().ok().copied())
+            .collect();
+        let reference: Vec<F::Input> = run.cycles.iter().map(|c| c.reference).collect();
+        for (i, c) in run.cycles.iter_mut().enumerate() {
+            if let (Ok(d), Some(j)) = (&mut c.dut, self.family.judged(&device, &reference, i)) {
+                *d = j;
+            }
+        }
         let bad_steps = if tol.motion {
             self.judge_motion(run, tol)
         } else {
