@@ -433,6 +433,93 @@ impl Gen<'_> {
         }
     }
 
+    /// One case per parameter that may be written only at a standstill (spec `conditions`
+    /// `standstill`, 3.3): a run to half the upper limit (par 42), the parameter written with
+    /// its delivery value while the drive runs: error 17 (3.8), the requirement of the
+    /// parameter's standstill rule cited with PSD-PKW-030.
+    fn standstill_cases(&mut self) -> Result<(), String> {
+        let run = control(self.family, "release-and-transfer")?;
+        let upper = self
+            .family
+            .parameter("42")
+            .and_then(|p| self.family.resolve(p, Some(self.model)).default)
+            .ok_or("par 42 has no delivery value")?;
+        let target = i32::try_from(upper / 2).map_err(|e| format!("par 42 / 2: {e}"))?;
+        let params: Vec<&Parameter> = self
+            .family
+            .parameters
+            .iter()
+            .filter(|p| p.has_condition("standstill") && p.access.writable())
+            .collect();
+        for p in params {
+            let (Ok(pnu), Some(width)) = (u16::try_from(p.number), Self::width(p)) else {
+                continue;
+            };
+            let num = p.number;
+            let value = self
+                .family
+                .resolve(p, Some(self.model))
+                .default
+                .or_else(|| self.range(p).map(|r| r.0))
+                .unwrap_or(0);
+            let mut steps = vec![
+                step(
+                    Role::Setup,
+                    format!("control {run:#06x}, target {target}"),
+                    Step::Process {
+                        control: Some(run),
+                        target: Some(target),
+                    },
+                ),
+                step(
+                    Role::Setup,
+                    "until running",
+                    Step::Until {
+                        running: true,
+                        max: 200,
+                    },
+                ),
+            ];
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("write par {num} = {value} while running"),
+                Request::Write {
+                    pnu,
+                    index: None,
+                    width,
+                    value,
+                },
+            );
+            let mut reqs: Vec<String> = vec!["PSD-PKW-030".to_owned(), "PSD-PKW-019".to_owned()];
+            reqs.extend(
+                self.family
+                    .requirements
+                    .iter()
+                    .filter(|r| {
+                        r.params.contains(&p.id)
+                            && r.text.contains("only be written at a standstill")
+                    })
+                    .map(|r| r.id.clone()),
+            );
+            let reqs: Vec<&str> = reqs.iter().map(String::as_str).collect();
+            self.push(
+                format!("psd4xx/pkw/error/operating-state/{num}"),
+                &reqs,
+                format!(
+                    "write par {num} ({}) during a run: error 17, it may be written only at a standstill",
+                    p.name
+                ),
+                PsdCase {
+                    steps,
+                    tol: MOTION,
+                    plot: false,
+                },
+            );
+        }
+        Ok(())
+    }
+
     fn record_write(&self, index: u16, control: u8, value: i64) -> Result<Step, String> {
         let p = self
             .family
@@ -992,6 +1079,7 @@ pub(crate) fn generate(
     };
     g.pkw_cases();
     g.pkw_rules_cases();
+    g.standstill_cases()?;
     g.record_cases()?;
     g.sequence_cases();
     g.scenario_cases();
