@@ -4,7 +4,10 @@
 //! reply. A family supplies its images, its steps and its reply comparison through
 //! [`CyclicFamily`].
 
-use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::case::{
+    Answer, CaseInfo, CaseRun, Failure, Finding as CaseFinding, Outcome, Record, RequirementRef,
+    Role,
+};
 use crate::cyclic::device::Device;
 use crate::cyclic::{Env, LinkPeer, LocalPeer, Peer, PeerError, Reply, Request, Server};
 use crate::dut::Dut;
@@ -51,6 +54,21 @@ pub(crate) const MOTION: Tolerance = Tolerance {
     speed: 2,
     motion: true,
 };
+
+/// A point of a motion case the manual leaves open (a silent point): the status bits and,
+/// with `movement`, the direction of travel there are not judged; the case reports what the
+/// device showed as a finding.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct OpenPoint {
+    /// The requirement the point belongs to.
+    pub requirement: String,
+    /// What the manual leaves open.
+    pub text: String,
+    /// The status bits not judged.
+    pub bits: u16,
+    /// Whether the direction of travel is not judged either.
+    pub movement: bool,
+}
 
 /// One step: who it is for, one line, what it does.
 #[derive(Debug, Clone, PartialEq)]
@@ -185,6 +203,16 @@ pub(crate) trait CyclicFamily<'s> {
         at: usize,
     ) -> Option<Self::Input> {
         device.get(at).copied().flatten()
+    }
+    /// The other readings of the errata that bear on a case (`spec errata`), each with a
+    /// reference server that follows it: a case the device fails against the adopted reading
+    /// passes when it passes against one of them, reporting which. By default none.
+    fn readings(&self, _info: &CaseInfo) -> Vec<(CaseFinding, Server<'s>)> {
+        Vec::new()
+    }
+    /// The point of a motion case the manual leaves open, if any. By default none.
+    fn open(_case: &Self::Case) -> Option<OpenPoint> {
+        None
     }
 }
 
@@ -431,6 +459,8 @@ struct Run<'r, 's, I, O> {
     reqs: &'r [String],
     /// The cycle counts at which [`Op::Until`] waits ended: both sides had arrived.
     arrivals: Vec<usize>,
+    /// The point the manual leaves open ([`CyclicFamily::open`]).
+    open: Option<OpenPoint>,
 }
 
 impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
@@ -794,7 +824,8 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             };
             let segment = run.cycles.get(from..to).unwrap_or(&[]);
             let before = from.checked_sub(1).and_then(|i| run.cycles.get(i));
-            for bit in 0..16u16 {
+            let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
+            for bit in (0..16u16).filter(|b| open_bits & (1 << b) == 0) {
                 let mask = 1u16 << bit;
                 let what = |v: Option<bool>| match v {
                     Some(true) => "set",
@@ -829,6 +860,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 Some(_) => "decreasing",
                 None => "no further movement",
             };
+            let movement_open = run.open.as_ref().is_some_and(|o| o.movement);
             if let Some(x) = first_difference(
                 before,
                 segment,
@@ -836,7 +868,9 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 |i| F::motion(i).1.signum(),
                 |v| *v == 0,
                 None,
-            ) {
+            )
+            .filter(|_| !movement_open)
+            {
                 bad.push(Finding::at(
                     x.at,
                     run.cycles.get(x.at).map_or(0, |c| c.step),
@@ -929,7 +963,8 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             // otherwise (an obstruction, a lost connection), where it stops depends on timing.
             let (dp, rp) = (F::motion(d).0, F::motion(&c.reference).0);
             let at_target = F::motion(&c.reference).2 & reached != 0;
-            let same_status = F::motion(d).2 == F::motion(&c.reference).2;
+            let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
+            let same_status = F::motion(d).2 & !open_bits == F::motion(&c.reference).2 & !open_bits;
             if !same_status || (at_target && (dp - rp).abs() > tol.position) {
                 bad.push(Finding::at(
                     i,
@@ -1022,12 +1057,29 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     }
 
     /// Runs one case (a generated one, or a fuzz sequence) against the device and a fresh
-    /// reference.
+    /// reference; a failed case again against each other reading of the errata that bear on
+    /// it ([`CyclicFamily::readings`]): it passes with the reading it follows as a finding.
     pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &F::Case) -> CaseRun {
+        let first = self.run_against(info, case, self.family.server());
+        if !first.outcome.failed() {
+            return first;
+        }
+        for (finding, server) in self.family.readings(info) {
+            let mut again = self.run_against(info, case, server);
+            if !again.outcome.failed() {
+                again.findings.push(finding);
+                return again;
+            }
+        }
+        first
+    }
+
+    /// Runs one case against the device and the reference `server`.
+    fn run_against(&mut self, info: &CaseInfo, case: &F::Case, server: Server<'s>) -> CaseRun {
         let (steps, tol) = (F::steps(case), F::tolerance(case));
         self.device.clear_error();
         let mut run = Run {
-            reference: self.family.server(),
+            reference: server,
             tol,
             out: self.family.start(case),
             t: 0,
@@ -1037,6 +1089,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             failure: None,
             reqs: &info.requirements,
             arrivals: Vec::new(),
+            open: F::open(case),
         };
         let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),
@@ -1096,8 +1149,23 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 note: Some(plot::encode(&samples)),
             });
         }
+        // An open point is reported with the status bits the device ended with.
+        let findings = match (&run.open, &run.failure) {
+            (Some(o), None) => {
+                let last = run.cycles.iter().rev().find_map(|c| c.dut.as_ref().ok());
+                let bits = last.map_or(0, |d| F::motion(d).2 & o.bits);
+                vec![CaseFinding::Open {
+                    requirement: o.requirement.clone(),
+                    text: format!(
+                        "{}; the device ended with the open status bits at {bits:#06x}",
+                        o.text
+                    ),
+                }]
+            }
+            _ => Vec::new(),
+        };
         CaseRun {
-            findings: Vec::new(),
+            findings,
             outcome: match run.failure {
                 Some(f) => Outcome::Fail(f),
                 None => Outcome::Pass,

@@ -1,9 +1,9 @@
 //! Running PSD4xx cases ([`crate::cyclic_session`]): every cycle's input image (PKW block and
 //! status word exact) and every record and injection reply is compared with the reference's.
 
-use super::cases::{status_bit, PsdCase, StepDef, PKW_MAX_CYCLES};
+use super::cases::{status_bit, OpenPoint, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
-use crate::case::CaseInfo;
+use crate::case::{CaseInfo, Finding};
 use crate::cyclic::{Reply, Request, Server};
 use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
 use drivespec_psd4xx::pkw::Reply as PkwReply;
@@ -119,6 +119,10 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
 
     fn plot(case: &PsdCase) -> bool {
         case.plot
+    }
+
+    fn open(case: &PsdCase) -> Option<OpenPoint> {
+        case.open.clone()
     }
 
     /// Idle: no PKW command, control word and target 0.
@@ -301,6 +305,29 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
             Step::Env { env } => env_request(t, env).map_or(Op::Hold(0), Op::Exchange),
             Step::Advance { us } => Op::Advance(*us),
         }
+    }
+
+    /// Every other reading of each selectable erratum (spec `option`) whose requirements the
+    /// case covers.
+    fn readings(&self, info: &CaseInfo) -> Vec<(Finding, Server<'static>)> {
+        let mut out = Vec::new();
+        for e in &self.suite.family().errata {
+            let Some(option) = &e.option else { continue };
+            if !e.requirements.iter().any(|r| info.requirements.contains(r)) {
+                continue;
+            }
+            for r in e.readings.iter().filter(|r| r.id != e.adopted) {
+                if let Some(server) = self.suite.reading_server(option, &r.id) {
+                    let finding = Finding::Reading {
+                        erratum: e.id.clone(),
+                        reading: r.id.clone(),
+                        text: r.text.clone(),
+                    };
+                    out.push((finding, server));
+                }
+            }
+        }
+        out
     }
 
     /// A read of a live value is judged by the device's own process data around it

@@ -23,6 +23,11 @@ pub enum Kind {
     /// Identity and measured values (spec `per_device`) of its own: another serial number,
     /// production date, version, temperature, current.
     OwnValues,
+    /// The other reading (second field) of a selectable erratum (first field, spec `option`).
+    Reading(&'static str, &'static str),
+    /// A motor voltage exactly at the UMot limit (par 90) counts as this many 0.1 V above it
+    /// (3.6 leaves the limit itself open).
+    UmotAtLimit(i16),
 }
 
 /// The reference PSD 401 with the freedom `kind` taken.
@@ -44,7 +49,14 @@ pub struct Variant {
 impl Variant {
     /// The variant `kind`.
     pub fn new(kind: Kind) -> Variant {
-        let drive = Drive::new(spec(), DriveConfig::new("PSD401-5V")).unwrap();
+        let mut readings = drivespec_spec::Readings::default();
+        if let Kind::Reading(option, reading) = kind {
+            readings
+                .choose(spec().family(FamilyId::Psd4xx), option, reading)
+                .unwrap();
+        }
+        let config = DriveConfig::new("PSD401-5V").with_readings(readings);
+        let drive = Drive::new(spec(), config).unwrap();
         Variant {
             kind,
             drive,
@@ -163,6 +175,14 @@ impl CyclicDevice<'static> for Variant {
     }
 
     fn env(&mut self, now: Micros, env: Env) -> bool {
+        let env = match (self.kind, env) {
+            (Kind::UmotAtLimit(by), Env::MotorVoltage(v))
+                if self.drive.parameter(90).ok() == Some(i64::from(v)) =>
+            {
+                Env::MotorVoltage(v.saturating_add_signed(by))
+            }
+            (_, e) => e,
+        };
         self.drive.env(now, env)
     }
 
@@ -180,6 +200,13 @@ pub fn variants() -> Vec<(&'static str, Kind)> {
         ("start latency 30 ms", Kind::StartLatency(30_000)),
         ("bit 0 10 ms after arrival", Kind::ReachedLater(10_000)),
         ("save answered after 900 ms", Kind::SlowSave(900_000)),
+        ("save answered after 1 s", Kind::SlowSave(1_000_000)),
+        ("U_mot at the limit counts as above", Kind::UmotAtLimit(1)),
+        ("U_mot at the limit counts as below", Kind::UmotAtLimit(-1)),
+        (
+            "par 38 writable while running",
+            Kind::Reading("par38-standstill", "par-39-only"),
+        ),
         ("identity and measurements of its own", Kind::OwnValues),
     ]
 }
