@@ -228,7 +228,15 @@ impl Gen<'_> {
                 &format!("read par {num}"),
                 Request::Read { pnu, index: None },
             );
-            let mut reqs = vec!["PSD-PKW-001", "PSD-PKW-011", "PSD-PKW-012", "PSD-PKW-006"];
+            let mut reqs = vec![
+                "PSD-PKW-001",
+                "PSD-PKW-011",
+                "PSD-PKW-012",
+                "PSD-PKW-006",
+                "PSD-PKW-008",
+                "PSD-PKW-009",
+                "PSD-PKW-021",
+            ];
             if Self::width(p) == Some(Width::Word) {
                 reqs.push("PSD-PKW-038");
             }

@@ -11,6 +11,9 @@ use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::{Input, Output, PkwRequest, PkwResponse};
 use drivespec_spec::{DataType, Family, FamilyId, Protocol};
 
+/// The value of one process-data field of an input image.
+type ImageValue = fn(&Input) -> i64;
+
 /// A session on one device under test.
 pub(crate) type Psd4xxSession<'a, 's> = CyclicSession<'a, Psd4xx<'a, 's>>;
 
@@ -39,7 +42,7 @@ impl<'a, 's> Psd4xx<'a, 's> {
     /// a process-data field (spec `live`, `process_data.input` `param`: status word, speed,
     /// actual position), and whether its values are bits (compared as a set) rather than a
     /// quantity (compared as a range).
-    fn image_of(&self, pnu: u16) -> Option<(fn(&Input) -> i64, bool)> {
+    fn image_of(&self, pnu: u16) -> Option<(ImageValue, bool)> {
         let family = self.suite.family();
         let p = family
             .parameters
@@ -54,7 +57,7 @@ impl<'a, 's> Psd4xx<'a, 's> {
             .fields
             .iter()
             .find(|f| f.param.as_deref() == Some(p.id.as_str()))?;
-        let value: fn(&Input) -> i64 = match field.name.as_str() {
+        let value: ImageValue = match field.name.as_str() {
             "status" => |i| i64::from(i.status),
             "speed" => |i| i64::from(i.speed),
             "actual" => |i| i64::from(i.actual),
