@@ -4,7 +4,10 @@
 //! reply. A family supplies its images, its steps and its reply comparison through
 //! [`CyclicFamily`].
 
-use crate::case::{Answer, CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
+use crate::case::{
+    Answer, CaseInfo, CaseRun, Failure, Finding as CaseFinding, Outcome, Record, RequirementRef,
+    Role,
+};
 use crate::cyclic::device::Device;
 use crate::cyclic::{Env, LinkPeer, LocalPeer, Peer, PeerError, Reply, Request, Server};
 use crate::dut::Dut;
@@ -51,6 +54,21 @@ pub(crate) const MOTION: Tolerance = Tolerance {
     speed: 2,
     motion: true,
 };
+
+/// A point of a motion case the manual leaves open (a silent point): the status bits and,
+/// with `movement`, the direction of travel there are not judged; the case reports what the
+/// device showed as a finding.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct OpenPoint {
+    /// The requirement the point belongs to.
+    pub requirement: String,
+    /// What the manual leaves open.
+    pub text: String,
+    /// The status bits not judged.
+    pub bits: u16,
+    /// Whether the direction of travel is not judged either.
+    pub movement: bool,
+}
 
 /// One step: who it is for, one line, what it does.
 #[derive(Debug, Clone, PartialEq)]
@@ -173,6 +191,29 @@ pub(crate) trait CyclicFamily<'s> {
     ) -> Op<Self::Output>;
     /// Whether an input image answers `action` (ends an [`Op::Send`] once both sides have).
     fn answered(&self, action: &Self::Action, reference: &Self::Input) -> bool;
+    /// The device's input of cycle `at` as it is judged against the reference's (`device` and
+    /// `reference` hold every cycle's input, None where none came): a family may put the
+    /// reference's value in place of a value the device read itself at the moment of a
+    /// request where the manual bounds that value by the device's own data. By default the
+    /// input as it came.
+    fn judged(
+        &self,
+        device: &[Option<Self::Input>],
+        _reference: &[Self::Input],
+        at: usize,
+    ) -> Option<Self::Input> {
+        device.get(at).copied().flatten()
+    }
+    /// The other readings of the errata that bear on a case (`spec errata`), each with a
+    /// reference server that follows it: a case the device fails against the adopted reading
+    /// passes when it passes against one of them, reporting which. By default none.
+    fn readings(&self, _info: &CaseInfo) -> Vec<(CaseFinding, Server<'s>)> {
+        Vec::new()
+    }
+    /// The point of a motion case the manual leaves open, if any. By default none.
+    fn open(_case: &Self::Case) -> Option<OpenPoint> {
+        None
+    }
 }
 
 /// The peer of the device under test `dut`; `sim` is the reference server of `model`, built
@@ -418,6 +459,8 @@ struct Run<'r, 's, I, O> {
     reqs: &'r [String],
     /// The cycle counts at which [`Op::Until`] waits ended: both sides had arrived.
     arrivals: Vec<usize>,
+    /// The point the manual leaves open ([`CyclicFamily::open`]).
+    open: Option<OpenPoint>,
 }
 
 impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
@@ -666,6 +709,17 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
 
     /// Judges the cycles under `tol`; marks the records and sets the first failure.
     fn judge(&self, run: &mut Run<'_, 's, F::Input, F::Output>, tol: Tolerance) {
+        let device: Vec<Option<F::Input>> = run
+            .cycles
+            .iter()
+            .map(|c| c.dut.as_ref().ok().copied())
+            .collect();
+        let reference: Vec<F::Input> = run.cycles.iter().map(|c| c.reference).collect();
+        for (i, c) in run.cycles.iter_mut().enumerate() {
+            if let (Ok(d), Some(j)) = (&mut c.dut, self.family.judged(&device, &reference, i)) {
+                *d = j;
+            }
+        }
         let bad_steps = if tol.motion {
             self.judge_motion(run, tol)
         } else {
@@ -770,7 +824,8 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             };
             let segment = run.cycles.get(from..to).unwrap_or(&[]);
             let before = from.checked_sub(1).and_then(|i| run.cycles.get(i));
-            for bit in 0..16u16 {
+            let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
+            for bit in (0..16u16).filter(|b| open_bits & (1 << b) == 0) {
                 let mask = 1u16 << bit;
                 let what = |v: Option<bool>| match v {
                     Some(true) => "set",
@@ -805,6 +860,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 Some(_) => "decreasing",
                 None => "no further movement",
             };
+            let movement_open = run.open.as_ref().is_some_and(|o| o.movement);
             if let Some(x) = first_difference(
                 before,
                 segment,
@@ -812,7 +868,9 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 |i| F::motion(i).1.signum(),
                 |v| *v == 0,
                 None,
-            ) {
+            )
+            .filter(|_| !movement_open)
+            {
                 bad.push(Finding::at(
                     x.at,
                     run.cycles.get(x.at).map_or(0, |c| c.step),
@@ -905,7 +963,8 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             // otherwise (an obstruction, a lost connection), where it stops depends on timing.
             let (dp, rp) = (F::motion(d).0, F::motion(&c.reference).0);
             let at_target = F::motion(&c.reference).2 & reached != 0;
-            let same_status = F::motion(d).2 == F::motion(&c.reference).2;
+            let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
+            let same_status = F::motion(d).2 & !open_bits == F::motion(&c.reference).2 & !open_bits;
             if !same_status || (at_target && (dp - rp).abs() > tol.position) {
                 bad.push(Finding::at(
                     i,
@@ -1028,10 +1087,33 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     /// Runs one case (a generated one, or a fuzz sequence) against the device and a fresh
     /// reference.
     pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &F::Case) -> CaseRun {
+        self.run_against(info, case, self.family.server())
+    }
+
+    /// Runs a suite case as [`CyclicSession::run_case`]; a failed case again against each
+    /// other reading of the errata that bear on it ([`CyclicFamily::readings`]): it passes
+    /// with the reading it follows as a finding.
+    fn run_suite_case(&mut self, info: &CaseInfo, case: &F::Case) -> CaseRun {
+        let first = self.run_case(info, case);
+        if !first.outcome.failed() {
+            return first;
+        }
+        for (finding, server) in self.family.readings(info) {
+            let mut again = self.run_against(info, case, server);
+            if !again.outcome.failed() {
+                again.findings.push(finding);
+                return again;
+            }
+        }
+        first
+    }
+
+    /// Runs one case against the device and the reference `server`.
+    fn run_against(&mut self, info: &CaseInfo, case: &F::Case, server: Server<'s>) -> CaseRun {
         let (steps, tol) = (F::steps(case), F::tolerance(case));
         self.device.clear_error();
         let mut run = Run {
-            reference: self.family.server(),
+            reference: server,
             tol,
             out: self.family.start(case),
             t: 0,
@@ -1041,6 +1123,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             failure: None,
             reqs: &info.requirements,
             arrivals: Vec::new(),
+            open: F::open(case),
         };
         let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),
@@ -1101,8 +1184,23 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 note: Some(plot::encode(&samples)),
             });
         }
+        // An open point is reported with the status bits the device ended with.
+        let findings = match (&run.open, &run.failure) {
+            (Some(o), None) => {
+                let last = run.cycles.iter().rev().find_map(|c| c.dut.as_ref().ok());
+                let bits = last.map_or(0, |d| F::motion(d).2 & o.bits);
+                vec![CaseFinding::Open {
+                    requirement: o.requirement.clone(),
+                    text: format!(
+                        "{}; the device ended with the open status bits at {bits:#06x}",
+                        o.text
+                    ),
+                }]
+            }
+            _ => Vec::new(),
+        };
         CaseRun {
-            findings: Vec::new(),
+            findings,
             checked: self.checked(&run),
             outcome: match run.failure {
                 Some(f) => Outcome::Fail(f),
@@ -1133,6 +1231,6 @@ impl<'s, F: CyclicFamily<'s>> Session for CyclicSession<'_, F> {
         };
         // The case borrows the family; run a copy of it.
         let (info, case) = (info.clone(), case.clone());
-        self.run_case(&info, &case)
+        self.run_suite_case(&info, &case)
     }
 }

@@ -53,10 +53,19 @@ fn mutant(kind: Kind, name: &str) -> Device {
 /// parameter (write, save, par 96, read back).
 const LIMIT: usize = 5;
 
+/// Mutants whose deviation a random run of this bound cannot reach, each caught by the suite
+/// instead: swapped limit bits show only when a manual run reaches an end limit (805,200
+/// increments at delivery), which `psd4xx/sequence/seq-manual-run-to-upper-limit` reaches by
+/// lowering par 42 first.
+const BEYOND_REACH: &[&str] = &["limit-bits-swapped"];
+
 #[test]
 fn every_psd4xx_mutant_is_found_with_a_short_replay() {
     let opts = options();
-    let all = mutants();
+    let all: Vec<_> = mutants()
+        .into_iter()
+        .filter(|m| !BEYOND_REACH.contains(&m.name))
+        .collect();
     let results: Vec<(String, Kind, fuzz::Summary)> = std::thread::scope(|s| {
         let handles: Vec<_> = all
             .iter()

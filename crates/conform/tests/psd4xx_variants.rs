@@ -1,7 +1,5 @@
 //! PSD4xx legal variants (`support::psd4xx_variants`): drives that differ from the reference
-//! only where the manual allows must pass every case; a later start every case outside the
-//! PKW group (a PKW exchange during a run still compares the value of the moment with the
-//! reference's). The cases each variant fails are printed.
+//! only where the manual allows must pass every case. The cases each variant fails are printed.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -16,10 +14,7 @@ use drivespec_conform::psd4xx::Psd4xxSuite;
 use drivespec_conform::suite::{Settings, Suite};
 use support::legal::{describe, failures};
 use support::mutants::spec;
-use support::psd4xx_variants::{variants, Kind, Variant};
-
-/// The cases a later start is not yet judged by: PKW exchanges, some during a run.
-const PKW: &str = "psd4xx/pkw/";
+use support::psd4xx_variants::{variants, Variant};
 
 #[test]
 fn every_psd4xx_legal_variant_passes() {
@@ -31,11 +26,7 @@ fn every_psd4xx_legal_variant_passes() {
         let failed = failures(suite.cases(), &mut session);
         let ids: Vec<&str> = failed.iter().map(|(id, _)| id.as_str()).collect();
         println!("{name:<36} fails {:>3} case(s): {ids:?}", failed.len());
-        let judged: Vec<_> = failed
-            .into_iter()
-            .filter(|(id, _)| !matches!(kind, Kind::StartLatency(_)) || !id.starts_with(PKW))
-            .collect();
-        problems.extend(describe(name, &judged));
+        problems.extend(describe(name, &failed));
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

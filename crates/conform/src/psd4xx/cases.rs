@@ -19,7 +19,7 @@ pub(crate) const PKW_MAX_CYCLES: u32 = 8;
 /// One step of a case.
 pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
 
-pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
+pub(crate) use crate::cyclic_session::{OpenPoint, Tolerance, MOTION};
 
 /// Tolerance of the PKW and record cases: the answer may come one cycle late.
 pub(crate) const EXCHANGE: Tolerance = Tolerance {
@@ -38,6 +38,8 @@ pub(crate) struct PsdCase {
     pub tol: Tolerance,
     /// Whether the report gets a position/speed/status plot.
     pub plot: bool,
+    /// The point the manual leaves open in a motion case.
+    pub open: Option<OpenPoint>,
 }
 
 struct Gen<'a> {
@@ -194,6 +196,7 @@ impl Gen<'_> {
                             steps,
                             tol: EXCHANGE,
                             plot: false,
+                            open: None,
                         },
                     );
                 }
@@ -212,6 +215,7 @@ impl Gen<'_> {
                         steps,
                         tol: EXCHANGE,
                         plot: false,
+                        open: None,
                     },
                 );
                 continue;
@@ -224,7 +228,15 @@ impl Gen<'_> {
                 &format!("read par {num}"),
                 Request::Read { pnu, index: None },
             );
-            let mut reqs = vec!["PSD-PKW-001", "PSD-PKW-011", "PSD-PKW-012", "PSD-PKW-006"];
+            let mut reqs = vec![
+                "PSD-PKW-001",
+                "PSD-PKW-011",
+                "PSD-PKW-012",
+                "PSD-PKW-006",
+                "PSD-PKW-008",
+                "PSD-PKW-009",
+                "PSD-PKW-021",
+            ];
             if Self::width(p) == Some(Width::Word) {
                 reqs.push("PSD-PKW-038");
             }
@@ -236,6 +248,7 @@ impl Gen<'_> {
                     steps,
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
             let Some(width) = Self::width(p) else {
@@ -267,6 +280,7 @@ impl Gen<'_> {
                         steps,
                         tol: EXCHANGE,
                         plot: false,
+                        open: None,
                     },
                 );
                 continue;
@@ -329,6 +343,7 @@ impl Gen<'_> {
                         steps,
                         tol: EXCHANGE,
                         plot: false,
+                        open: None,
                     },
                 );
             }
@@ -364,6 +379,7 @@ impl Gen<'_> {
                     steps,
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
         }
@@ -393,6 +409,7 @@ impl Gen<'_> {
                     steps,
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
         }
@@ -428,9 +445,144 @@ impl Gen<'_> {
                     ],
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
         }
+    }
+
+    /// One case per parameter that may be written only at a standstill (spec `conditions`
+    /// `standstill`, 3.3): a run to half the upper limit (par 42), the parameter written with
+    /// its delivery value while the drive runs: error 17 (3.8), the requirement of the
+    /// parameter's standstill rule cited with PSD-PKW-030.
+    fn standstill_cases(&mut self) -> Result<(), String> {
+        let run = control(self.family, "release-and-transfer")?;
+        let upper = self
+            .family
+            .parameter("42")
+            .and_then(|p| self.family.resolve(p, Some(self.model)).default)
+            .ok_or("par 42 has no delivery value")?;
+        let target = i32::try_from(upper / 2).map_err(|e| format!("par 42 / 2: {e}"))?;
+        let params: Vec<&Parameter> = self
+            .family
+            .parameters
+            .iter()
+            .filter(|p| p.has_condition("standstill") && p.access.writable())
+            .collect();
+        for p in params {
+            let (Ok(pnu), Some(width)) = (u16::try_from(p.number), Self::width(p)) else {
+                continue;
+            };
+            let num = p.number;
+            let value = self
+                .family
+                .resolve(p, Some(self.model))
+                .default
+                .or_else(|| self.range(p).map(|r| r.0))
+                .unwrap_or(0);
+            let mut steps = vec![
+                step(
+                    Role::Setup,
+                    format!("control {run:#06x}, target {target}"),
+                    Step::Process {
+                        control: Some(run),
+                        target: Some(target),
+                    },
+                ),
+                step(
+                    Role::Setup,
+                    "until running",
+                    Step::Until {
+                        running: true,
+                        max: 200,
+                    },
+                ),
+            ];
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("write par {num} = {value} while running"),
+                Request::Write {
+                    pnu,
+                    index: None,
+                    width,
+                    value,
+                },
+            );
+            let mut reqs: Vec<String> = vec!["PSD-PKW-030".to_owned(), "PSD-PKW-019".to_owned()];
+            reqs.extend(
+                self.family
+                    .requirements
+                    .iter()
+                    .filter(|r| {
+                        r.params.contains(&p.id)
+                            && r.text.contains("only be written at a standstill")
+                    })
+                    .map(|r| r.id.clone()),
+            );
+            let reqs: Vec<&str> = reqs.iter().map(String::as_str).collect();
+            self.push(
+                format!("psd4xx/pkw/error/operating-state/{num}"),
+                &reqs,
+                format!(
+                    "write par {num} ({}) during a run: error 17, it may be written only at a standstill",
+                    p.name
+                ),
+                PsdCase {
+                    steps,
+                    tol: MOTION,
+                    plot: false,
+                    open: None,
+                },
+            );
+        }
+        Ok(())
+    }
+
+    /// The motor voltage exactly at the UMot limit (par 90's delivery value): 3.6 sets bit 4
+    /// above the limit and bit 13 below it, and says nothing of the limit itself; the case
+    /// reports which bits the device shows.
+    fn umot_limit_case(&mut self) -> Result<(), String> {
+        let p90 = self.family.parameter("90").ok_or("no par 90")?;
+        let limit = self
+            .family
+            .resolve(p90, Some(self.model))
+            .default
+            .ok_or("par 90 has no delivery value")?;
+        let bits = status_bit(self.family, "Power supply to motor available")?
+            | status_bit(self.family, "Motor voltage was missing")?;
+        let steps = vec![
+            step(
+                Role::Check,
+                format!("motor voltage {limit} (par 90)"),
+                Step::Env {
+                    env: Env::MotorVoltage(
+                        u16::try_from(limit).map_err(|e| format!("par 90: {e}"))?,
+                    )
+                    .to_string(),
+                },
+            ),
+            step(Role::Check, "settle", Step::Hold { cycles: 50 }),
+        ];
+        self.push(
+            "psd4xx/status/umot-at-limit".to_owned(),
+            &["PSD-STS-4-SET-1", "PSD-STS-13-SET-1"],
+            format!("the motor voltage exactly at the UMot limit (par 90 = {limit}): bits 4 and 13 are open"),
+            PsdCase {
+                steps,
+                tol: MOTION,
+                plot: false,
+                open: Some(OpenPoint {
+                    requirement: "PSD-STS-4-SET-1".to_owned(),
+                    text: format!(
+                        "motor voltage equal to the UMot limit ({limit}): 3.6 sets bit 4 above the limit and bit 13 below it, the limit itself is open"
+                    ),
+                    bits,
+                    movement: false,
+                }),
+            },
+        );
+        Ok(())
     }
 
     fn record_write(&self, index: u16, control: u8, value: i64) -> Result<Step, String> {
@@ -491,6 +643,7 @@ impl Gen<'_> {
                     )],
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
             let Some(width) = width else { continue };
@@ -507,6 +660,7 @@ impl Gen<'_> {
                         steps: vec![step(Role::Check, format!("write record {num}"), w)],
                         tol: EXCHANGE,
                         plot: false,
+                        open: None,
                     },
                 );
                 continue;
@@ -532,6 +686,7 @@ impl Gen<'_> {
                     ],
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
             let w = self.record_write(index, ignore, max)?;
@@ -554,6 +709,7 @@ impl Gen<'_> {
                     ],
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
             if let Step::RecordWrite { hex: data, .. } = self.record_write(index, execute, min)? {
@@ -576,6 +732,7 @@ impl Gen<'_> {
                         ],
                         tol: EXCHANGE,
                         plot: false,
+                        open: None,
                     },
                 );
             }
@@ -593,6 +750,7 @@ impl Gen<'_> {
                     )],
                     tol: EXCHANGE,
                     plot: false,
+                    open: None,
                 },
             );
         }
@@ -757,6 +915,7 @@ impl Gen<'_> {
                     steps,
                     tol: MOTION,
                     plot: true,
+                    open: None,
                 },
             );
         }
@@ -799,6 +958,7 @@ impl Gen<'_> {
                     steps,
                     tol,
                     plot: typed.setup.plot,
+                    open: None,
                 },
             );
         }
@@ -913,6 +1073,29 @@ impl Gen<'_> {
             pnu: 44,
             index: None,
         };
+        // -5 and -4 move to the middle of the range, where the drive already stands: whether
+        // that is a run (status bits of a run, a reference loop) the manual does not say.
+        let run_bits = [
+            "Target position reached",
+            "Drive is running",
+            "Run in opposite direction to loop",
+        ]
+        .iter()
+        .map(|n| status_bit(self.family, n))
+        .collect::<Result<Vec<u16>, String>>()?
+        .into_iter()
+        .fold(0, |a, b| a | b);
+        let centre: std::collections::BTreeMap<i64, OpenPoint> = [(-5i64, "PSD-PAR-96-002"), (-4, "PSD-PAR-96-003")]
+            .into_iter()
+            .map(|(v, requirement)| {
+                (v, OpenPoint {
+                    requirement: requirement.to_owned(),
+                    text: format!("par 96 = {v} with the drive at the middle of the range already: the manual does not say whether the move there is a run (the status bits of a run, a reference loop)"),
+                    bits: run_bits,
+                    movement: true,
+                })
+            })
+            .collect();
         for (v, reqs) in [
             (-6i64, &["PSD-PAR-96-001"][..]),
             (-5, &["PSD-PAR-96-002"][..]),
@@ -968,7 +1151,12 @@ impl Gen<'_> {
                 format!("psd4xx/par96/{name}"),
                 reqs,
                 format!("par 44 saved and changed again, par 96 = {v}, read back, power cycle, read back"),
-                PsdCase { steps, tol: MOTION, plot: false },
+                PsdCase {
+                    steps,
+                    tol: MOTION,
+                    plot: false,
+                    open: centre.get(&v).cloned(),
+                },
             );
         }
         Ok(())
@@ -992,6 +1180,8 @@ pub(crate) fn generate(
     };
     g.pkw_cases();
     g.pkw_rules_cases();
+    g.standstill_cases()?;
+    g.umot_limit_case()?;
     g.record_cases()?;
     g.sequence_cases();
     g.scenario_cases();

@@ -106,6 +106,7 @@ impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
                 .collect(),
             tol: if moves { MOTION } else { EXCHANGE },
             plot: false,
+            open: None,
         };
         (info, case)
     }

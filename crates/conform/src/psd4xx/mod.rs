@@ -6,16 +6,22 @@
 //!
 //! | group | what |
 //! | --- | --- |
-//! | `pkw` | every parameter read; writes at both range edges and one beyond; read-only writes (error 1); unknown PNUs (error 0); par. 13 segments and count; "no command"/"no response"; the response held until the next command; every error code |
+//! | `pkw` | every parameter read; writes at both range edges and one beyond; read-only writes (error 1); unknown PNUs (error 0); standstill-only writes during a run (error 17); par. 13 segments and count; "no command"/"no response"; the response held until the next command; every error code |
 //! | `record` | every parameter read (2/4 bytes, the string); writes of 3/5 bytes with control byte 1, ignored with control byte 0, wrong lengths, unknown indices |
 //! | `sequence` | the spec's `sequence` vectors, step for step |
 //! | `position` | positioning with and without loop in both directions, manual runs, release withdrawal, a new target during a run |
-//! | `status` | status bits after power-on, at the target, toggle echo, obstruction, incorrect target |
+//! | `status` | status bits after power-on, at the target, toggle echo, obstruction, incorrect target, the motor voltage at the UMot limit |
 //! | `par96` | every par. 96 command and rejected values, with a power cycle after |
 //!
 //! Every cycle's input image of the device under test is compared with the reference's: PKW
-//! block and status word exactly; position and speed within the case's declared tolerance,
-//! and a time tolerance in cycles for the motion cases.
+//! block and status word exactly, position and speed within the case's declared tolerance, a
+//! time tolerance in cycles; motion cases by the properties of the run
+//! ([`crate::cyclic_session`]). A PKW read of a live value is judged by the device's own
+//! process data around the read (3.6, the value of the moment); the standstill-only
+//! parameters (spec `conditions`) are written during a run and must answer error 17; a case
+//! failing against the adopted reading of an erratum bearing on it passes when it passes
+//! against another reading, reporting which; points the manual leaves open are reported, not
+//! judged.
 
 pub(crate) mod cases;
 pub(crate) mod fuzz;
@@ -29,9 +35,9 @@ use crate::cyclic::{Peer, Server};
 use crate::dut::Dut;
 use crate::suite::{Session, Settings, SetupError, Suite};
 use cases::PsdCase;
-use drivespec_psd4xx::model::Drive;
+use drivespec_psd4xx::model::{Drive, DriveConfig};
 use drivespec_sim::reference::{self, Reference};
-use drivespec_spec::{Family, FamilyId, Spec};
+use drivespec_spec::{Family, FamilyId, Readings, Spec};
 
 /// The device model `--model` selects when none is given.
 pub use drivespec_sim::reference::PSD4XX_DEFAULT_MODEL as DEFAULT_MODEL;
@@ -49,6 +55,7 @@ pub const CYCLE_US: u64 = 10_000;
 
 /// The PSD4xx suite for one device model.
 pub struct Psd4xxSuite<'s> {
+    spec: &'s Spec,
     family: &'s Family,
     reference: Reference<'s, Drive>,
     infos: Vec<CaseInfo>,
@@ -63,6 +70,7 @@ impl<'s> Psd4xxSuite<'s> {
         let (infos, cases) =
             cases::generate(family, reference.model, &reference.drive).map_err(SetupError::Spec)?;
         Ok(Psd4xxSuite {
+            spec,
             family,
             reference,
             infos,
@@ -93,6 +101,23 @@ impl<'s> Psd4xxSuite<'s> {
     /// A session on `peer` with the family's own operations (greeting, injections, fuzzing).
     pub(crate) fn cyclic_session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psd4xxSession<'a, 's> {
         Psd4xxSession::new(Psd4xx::new(self), peer)
+    }
+
+    /// The reference drive following `reading` of erratum option `option` instead of the
+    /// adopted one, as a server.
+    pub(crate) fn reading_server(&self, option: &str, reading: &str) -> Option<Server<'static>> {
+        let mut readings = Readings::default();
+        readings.choose(self.family, option, reading).ok()?;
+        let config = DriveConfig::new(&self.reference.model.id).with_readings(readings);
+        let drive = Drive::new(self.spec, config).ok()?;
+        Some(Server::new(
+            &format!(
+                "drivespec reference {} ({option}={reading})",
+                self.reference.model.id
+            ),
+            FamilyId::Psd4xx.as_str(),
+            Box::new(drive),
+        ))
     }
 
     pub(crate) fn family(&self) -> &'s Family {

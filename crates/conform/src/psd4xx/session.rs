@@ -1,14 +1,18 @@
 //! Running PSD4xx cases ([`crate::cyclic_session`]): every cycle's input image (PKW block and
 //! status word exact) and every record and injection reply is compared with the reference's.
 
-use super::cases::{status_bit, PsdCase, StepDef, PKW_MAX_CYCLES};
+use super::cases::{status_bit, OpenPoint, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
-use crate::case::CaseInfo;
+use crate::case::{CaseInfo, Finding};
 use crate::cyclic::{Reply, Request, Server};
 use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
+use drivespec_psd4xx::pkw::Reply as PkwReply;
 use drivespec_psd4xx::step::Step;
-use drivespec_psd4xx::{Input, Output, PkwRequest};
-use drivespec_spec::{Family, FamilyId, Protocol};
+use drivespec_psd4xx::{Input, Output, PkwRequest, PkwResponse};
+use drivespec_spec::{DataType, Family, FamilyId, Protocol};
+
+/// The value of one process-data field of an input image.
+type ImageValue = fn(&Input) -> i64;
 
 /// A session on one device under test.
 pub(crate) type Psd4xxSession<'a, 's> = CyclicSession<'a, Psd4xx<'a, 's>>;
@@ -32,6 +36,38 @@ impl<'a, 's> Psd4xx<'a, 's> {
             .parameters
             .iter()
             .any(|p| p.per_device && p.number == u32::from(number))
+    }
+
+    /// What the input image shows of parameter `pnu` when the parameter is a live value with
+    /// a process-data field (spec `live`, `process_data.input` `param`: status word, speed,
+    /// actual position), and whether its values are bits (compared as a set) rather than a
+    /// quantity (compared as a range).
+    fn image_of(&self, pnu: u16) -> Option<(ImageValue, bool)> {
+        let family = self.suite.family();
+        let p = family
+            .parameters
+            .iter()
+            .find(|p| p.live && p.number == u32::from(pnu))?;
+        let Protocol::Psd4xx(proto) = &family.protocol else {
+            return None;
+        };
+        let field = proto
+            .process_data
+            .input
+            .fields
+            .iter()
+            .find(|f| f.param.as_deref() == Some(p.id.as_str()))?;
+        let value: ImageValue = match field.name.as_str() {
+            "status" => |i| i64::from(i.status),
+            "speed" => |i| i64::from(i.speed),
+            "actual" => |i| i64::from(i.actual),
+            _ => return None,
+        };
+        let bits = matches!(
+            p.data_type,
+            DataType::Bits8 | DataType::Bits16 | DataType::Bits32
+        );
+        Some((value, bits))
     }
 
     /// Most cycles a PKW command is repeated: the longest save (4.7, spec
@@ -86,6 +122,10 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
 
     fn plot(case: &PsdCase) -> bool {
         case.plot
+    }
+
+    fn open(case: &PsdCase) -> Option<OpenPoint> {
+        case.open.clone()
     }
 
     /// Idle: no PKW command, control word and target 0.
@@ -270,6 +310,36 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         }
     }
 
+    /// Every other reading of each selectable erratum (spec `option`) whose requirements the
+    /// case covers.
+    fn readings(&self, info: &CaseInfo) -> Vec<(Finding, Server<'static>)> {
+        let mut out = Vec::new();
+        for e in &self.suite.family().errata {
+            let Some(option) = &e.option else { continue };
+            if !e.requirements.iter().any(|r| info.requirements.contains(r)) {
+                continue;
+            }
+            for r in e.readings.iter().filter(|r| r.id != e.adopted) {
+                if let Some(server) = self.suite.reading_server(option, &r.id) {
+                    let finding = Finding::Reading {
+                        erratum: e.id.clone(),
+                        reading: r.id.clone(),
+                        text: r.text.clone(),
+                    };
+                    out.push((finding, server));
+                }
+            }
+        }
+        out
+    }
+
+    /// A read of a live value is judged by the device's own process data around it
+    /// ([`Psd4xx::moment`]); everything else as it came.
+    fn judged(&self, device: &[Option<Input>], reference: &[Input], at: usize) -> Option<Input> {
+        self.moment(device, reference, at)
+            .or_else(|| device.get(at).copied().flatten())
+    }
+
     /// A PKW block is answered when the reference's response answers it ("no command" and
     /// commands without an operation: when it says "no response").
     fn answered(&self, action: &Step, i: &Input) -> bool {
@@ -287,6 +357,68 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         } else {
             pkw.answers(req, &i.pkw)
         }
+    }
+}
+
+impl Psd4xx<'_, '_> {
+    /// A read of a live value with a process-data field answered at cycle `at` (3.6: the
+    /// value of the moment; PSD-PKW-004: held while the command is repeated), judged by the
+    /// device's own process data: the request begins where the reference's answer does (it
+    /// answers such a read in the cycle the request comes); the device's first answer to it
+    /// must be unchanged up to `at`, and its value must be one the device's own image showed
+    /// between the cycle before the request and the cycle after that answer (a quantity: within
+    /// their range; bits: one of them). Then the reference's answer stands in for it.
+    fn moment(&self, device: &[Option<Input>], reference: &[Input], at: usize) -> Option<Input> {
+        let mut d = device.get(at).copied().flatten()?;
+        let pkw = self.suite.reference().rules().pkw();
+        let Some(PkwReply::Value {
+            pnu,
+            index: None,
+            value,
+            ..
+        }) = pkw.reply(&d.pkw)
+        else {
+            return None;
+        };
+        let (image, bits) = self.image_of(pnu)?;
+        let same = |r: &PkwResponse| r.ak == d.pkw.ak && r.pnu == d.pkw.pnu && r.ind == d.pkw.ind;
+        let pkw_at = |k: usize| device.get(k).copied().flatten().map(|i| i.pkw);
+        // The device's answer: the cycles up to `at` with the same block.
+        let mut first = at;
+        while first > 0 && pkw_at(first - 1) == Some(d.pkw) {
+            first -= 1;
+        }
+        // The request: where the reference's answer to it begins.
+        let start = (0..=first).rev().find(|&k| {
+            reference.get(k).is_some_and(|r| same(&r.pkw))
+                && (k == 0 || reference.get(k - 1).is_none_or(|r| !same(&r.pkw)))
+        })?;
+        // No other answer to the same command between the request and this one.
+        if (start..first).any(|k| pkw_at(k).is_some_and(|p| same(&p))) {
+            return None;
+        }
+        let seen: Vec<i64> = device
+            .get(
+                start.saturating_sub(1)
+                    ..=first.saturating_add(1).min(device.len().saturating_sub(1)),
+            )
+            .unwrap_or(&[])
+            .iter()
+            .flatten()
+            .map(image)
+            .collect();
+        let within = if bits {
+            seen.contains(&value)
+        } else {
+            let lo = seen.iter().copied().min()?;
+            let hi = seen.iter().copied().max()?;
+            (lo..=hi).contains(&value)
+        };
+        if !within {
+            return None;
+        }
+        d.pkw = reference.get(start)?.pkw;
+        Some(d)
     }
 }
 

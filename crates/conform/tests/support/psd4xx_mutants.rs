@@ -47,6 +47,30 @@ pub enum Kind {
     RecordReadWide,
     /// Status bit 10 (obstruction) is never set.
     ObstructionBitMissing,
+    /// A write of a standstill-only parameter during a run is answered as accepted.
+    StandstillWritesAccepted,
+    /// Status bit 0 is set at a standstill within ten positioning windows of the target.
+    ReachedOutsideWindow,
+    /// Status bits 14 (positive limit) and 15 (negative limit) are swapped.
+    LimitBitsSwapped,
+    /// A run that ends outside the positioning window is not repeated: one attempt only.
+    NoSecondPositioning,
+}
+
+/// The built-in spec with one positioning attempt instead of two (4.2.1), as a drive that
+/// leaves out the second positioning is built.
+fn one_attempt() -> &'static drivespec_spec::Spec {
+    static SPEC: std::sync::OnceLock<drivespec_spec::Spec> = std::sync::OnceLock::new();
+    SPEC.get_or_init(|| {
+        let mut files = drivespec_spec::SpecFiles::builtin();
+        let path = "psd4xx/protocol.toml";
+        let text = files
+            .get(path)
+            .unwrap()
+            .replace("attempts = 2", "attempts = 1");
+        files.set(path, &text);
+        drivespec_spec::Spec::from_files(&files).unwrap()
+    })
 }
 
 #[derive(Clone)]
@@ -57,16 +81,20 @@ pub struct Mutant {
     last_response: Option<drivespec_psd4xx::PkwResponse>,
     running: bool,
     target_in_force: i32,
+    /// The target last transferred (control bit 2), if any.
+    transferred: Option<i32>,
 }
 
 impl Mutant {
     /// The reference PSD 401 with the deviation `kind`.
     pub fn new(kind: Kind) -> Mutant {
-        let drive = Drive::new(
-            spec(),
-            drivespec_psd4xx::model::DriveConfig::new("PSD401-5V"),
-        )
-        .unwrap();
+        let spec = if kind == Kind::NoSecondPositioning {
+            one_attempt()
+        } else {
+            spec()
+        };
+        let drive =
+            Drive::new(spec, drivespec_psd4xx::model::DriveConfig::new("PSD401-5V")).unwrap();
         Mutant {
             kind,
             drive,
@@ -74,6 +102,7 @@ impl Mutant {
             last_response: None,
             running: false,
             target_in_force: 0,
+            transferred: None,
         }
     }
 }
@@ -172,6 +201,33 @@ impl CyclicDevice<'static> for Mutant {
             Kind::SpeedSignInverted => input.speed = input.speed.wrapping_neg(),
             Kind::ObstructionBitMissing => {
                 input.status &= !bit("status", "Positioning error (obstruction)")
+            }
+            Kind::StandstillWritesAccepted
+                if input.pkw.ak == cannot && input.pkw.pwe == codes.operating_state.0 =>
+            {
+                input.pkw.ak = pkw.expected_response(&original.pkw).unwrap_or(input.pkw.ak);
+                input.pkw.pwe = original.pkw.pwe;
+            }
+            Kind::ReachedOutsideWindow => {
+                if original.control & transfer != 0 {
+                    self.transferred = Some(original.target);
+                }
+                let window = self.drive.parameter(44).unwrap_or(0);
+                let still = input.status & bit("status", "Drive is running") == 0;
+                if let Some(t) = self.transferred.filter(|_| still) {
+                    if (i64::from(input.actual) - i64::from(t)).abs() <= 10 * window {
+                        input.status |= bit("status", "Target position reached");
+                    }
+                }
+            }
+            Kind::LimitBitsSwapped => {
+                let (up, down) = (
+                    bit("status", "Positive range limit"),
+                    bit("status", "Negative range limit"),
+                );
+                let (u, d) = (input.status & up != 0, input.status & down != 0);
+                input.status &= !(up | down);
+                input.status |= if u { down } else { 0 } | if d { up } else { 0 };
             }
             _ => {}
         }
@@ -358,6 +414,41 @@ pub fn mutants() -> Vec<Case> {
             name: "record-read-16-bit-as-4-bytes",
             must_fail: &["psd4xx/record/read/44"],
             breaks: &["PSD-REC-*"],
+        },
+        Case {
+            kind: StandstillWritesAccepted,
+            name: "standstill-writes-accepted-while-running",
+            must_fail: &[
+                "psd4xx/pkw/error/operating-state/3",
+                "psd4xx/pkw/error/operating-state/37",
+                "psd4xx/pkw/error/operating-state/41",
+            ],
+            breaks: &[
+                "PSD-PKW-030",
+                "PSD-PAR-3-003",
+                "PSD-PAR-37-003",
+                "PSD-PAR-38-002",
+                "PSD-PAR-40-002",
+                "PSD-PAR-41-002",
+            ],
+        },
+        Case {
+            kind: ReachedOutsideWindow,
+            name: "bit-0-outside-the-window",
+            must_fail: &["psd4xx/sequence/seq-second-positioning"],
+            breaks: &["PSD-STS-0-*", "PSD-POS-013", "PSD-POS-014", "PSD-STS-10-*"],
+        },
+        Case {
+            kind: LimitBitsSwapped,
+            name: "limit-bits-swapped",
+            must_fail: &["psd4xx/sequence/seq-manual-run-to-upper-limit"],
+            breaks: &["PSD-STS-14-*", "PSD-STS-15-*"],
+        },
+        Case {
+            kind: NoSecondPositioning,
+            name: "no-second-positioning",
+            must_fail: &["psd4xx/sequence/seq-second-positioning"],
+            breaks: &["PSD-POS-013", "PSD-POS-014", "PSD-STS-10-*", "PSD-STS-0-*"],
         },
         Case {
             kind: ObstructionBitMissing,

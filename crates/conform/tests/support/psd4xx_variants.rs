@@ -23,6 +23,99 @@ pub enum Kind {
     /// Identity and measured values (spec `per_device`) of its own: another serial number,
     /// production date, version, temperature, current.
     OwnValues,
+    /// The other reading (second field) of a selectable erratum (first field, spec `option`).
+    Reading(&'static str, &'static str),
+    /// A motor voltage exactly at the UMot limit (par 90) counts as this many 0.1 V above it
+    /// (3.6 leaves the limit itself open).
+    UmotAtLimit(i16),
+    /// The shaft follows the trapezoid through a filter of its own (4.3 fixes only the maximum
+    /// acceleration and deceleration and a deceleration "successively reduced"): the run is
+    /// reported ended, and live values are read, from the filtered motion.
+    Shaft(Filter),
+}
+
+/// How the shaft follows the drive's trapezoid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    /// The mean over this many bus cycles: an S-curve (jerk-limited, never above the ramps).
+    Mean(usize),
+    /// A first-order lag with this time constant (µs): a braking tail of its own.
+    Lag(Micros),
+}
+
+/// The shaft of a [`Kind::Shaft`] variant: its own position and speed, and the status word it
+/// holds while it still moves after the trapezoid has ended.
+#[derive(Clone, Default)]
+struct Shaft {
+    /// Position (increments) and speed (rpm).
+    pos: f64,
+    speed: f64,
+    /// The trapezoid's last samples (position, speed), newest last.
+    samples: VecDeque<(f64, f64)>,
+    /// The trapezoid's sample of the cycle before.
+    before: Option<(f64, f64)>,
+    last: Option<Micros>,
+    /// The status word of the last cycle the trapezoid ran.
+    running_status: Option<u16>,
+    /// The PKW response as the drive gave it, and as the variant answers it.
+    pkw: Option<(PkwResponse, PkwResponse)>,
+}
+
+impl Shaft {
+    /// The shaft after the trapezoid's sample `(pos, speed)` at `now`.
+    fn follow(&mut self, filter: Filter, now: Micros, pos: f64, speed: f64) {
+        // A position that changes without motion is a new frame (par 3, 38-41 written): the
+        // shaft has not moved, its position shifts with the frame.
+        if let Some((p, _)) = self
+            .before
+            .filter(|(p, v)| *v == 0.0 && speed == 0.0 && *p != pos)
+        {
+            let shift = pos - p;
+            self.pos += shift;
+            for s in &mut self.samples {
+                s.0 += shift;
+            }
+        }
+        self.before = Some((pos, speed));
+        // The first sample: the shaft stands where the drive starts.
+        if self.last.is_none() {
+            self.snap(pos, speed);
+        }
+        match filter {
+            Filter::Mean(n) => {
+                self.samples.push_back((pos, speed));
+                while self.samples.len() > n.max(1) {
+                    self.samples.pop_front();
+                }
+                let k = self.samples.len().max(1) as f64;
+                self.pos = self.samples.iter().map(|s| s.0).sum::<f64>() / k;
+                self.speed = self.samples.iter().map(|s| s.1).sum::<f64>() / k;
+            }
+            Filter::Lag(tau) => {
+                let dt = now.saturating_sub(self.last.unwrap_or(now)) as f64;
+                let a = 1.0 - (-dt / tau.max(1) as f64).exp();
+                self.pos += a * (pos - self.pos);
+                self.speed += a * (speed - self.speed);
+            }
+        }
+        self.last = Some(now);
+        // Within half an increment and half an rpm the shaft stands on the trapezoid's end.
+        if (pos - self.pos).abs() < 0.5 && (speed - self.speed).abs() < 0.5 {
+            self.snap(pos, speed);
+        }
+    }
+
+    /// The shaft where the trapezoid is (power-up, a displacement by hand).
+    fn snap(&mut self, pos: f64, speed: f64) {
+        self.pos = pos;
+        self.speed = speed;
+        self.samples.clear();
+        self.samples.push_back((pos, speed));
+    }
+
+    fn settled(&self, pos: f64, speed: f64) -> bool {
+        self.pos == pos && self.speed == speed
+    }
 }
 
 /// The reference PSD 401 with the freedom `kind` taken.
@@ -39,12 +132,20 @@ pub struct Variant {
     reached_since: Option<Micros>,
     /// Since when the save command in force came.
     saving_since: Option<Micros>,
+    shaft: Shaft,
 }
 
 impl Variant {
     /// The variant `kind`.
     pub fn new(kind: Kind) -> Variant {
-        let drive = Drive::new(spec(), DriveConfig::new("PSD401-5V")).unwrap();
+        let mut readings = drivespec_spec::Readings::default();
+        if let Kind::Reading(option, reading) = kind {
+            readings
+                .choose(spec().family(FamilyId::Psd4xx), option, reading)
+                .unwrap();
+        }
+        let config = DriveConfig::new("PSD401-5V").with_readings(readings);
+        let drive = Drive::new(spec(), config).unwrap();
         Variant {
             kind,
             drive,
@@ -53,6 +154,7 @@ impl Variant {
             last_seen: (0, 0),
             reached_since: None,
             saving_since: None,
+            shaft: Shaft::default(),
         }
     }
 }
@@ -72,6 +174,75 @@ fn reached_bit() -> u16 {
         .bits
         .iter()
         .find(|x| x.name == "Target position reached")
+        .unwrap()
+        .bit
+}
+
+impl Variant {
+    /// The input image of a [`Kind::Shaft`] variant: position and speed of its own shaft;
+    /// while the shaft still moves after the trapezoid ended, the status word of the run;
+    /// a read of the status word, speed or actual value answered with its own value of the
+    /// moment and held while the command is repeated.
+    fn shaft_input(
+        &mut self,
+        filter: Filter,
+        now: Micros,
+        rules: &drivespec_psd4xx::Rules,
+        input: &mut Input,
+    ) {
+        let (pos, speed) = (f64::from(input.actual), f64::from(input.speed));
+        self.shaft.follow(filter, now, pos, speed);
+        let running = input.status & running_bit() != 0;
+        if running {
+            self.shaft.running_status = Some(input.status);
+        } else if self.shaft.settled(pos, speed) {
+            self.shaft.running_status = None;
+        } else if let Some(status) = self.shaft.running_status {
+            input.status = status;
+        }
+        input.actual = self.shaft.pos.round() as i32;
+        input.speed = self.shaft.speed.round() as i16;
+        let raw = input.pkw;
+        if let Some((_, answer)) = self.shaft.pkw.filter(|(b, _)| *b == raw) {
+            input.pkw = answer;
+            return;
+        }
+        let pkw = rules.pkw();
+        if let Some(drivespec_psd4xx::Reply::Value {
+            pnu,
+            index: None,
+            width,
+            ..
+        }) = pkw.reply(&raw)
+        {
+            let own = match pnu {
+                1 => Some(i64::from(input.status)),
+                2 => Some(i64::from(input.speed)),
+                3 => Some(i64::from(input.actual)),
+                _ => None,
+            };
+            if let Some(value) = own {
+                let reply = drivespec_psd4xx::Reply::Value {
+                    pnu,
+                    index: None,
+                    width,
+                    value,
+                };
+                if let Ok(r) = pkw.encode_reply(&reply) {
+                    input.pkw = r;
+                }
+            }
+        }
+        self.shaft.pkw = Some((raw, input.pkw));
+    }
+}
+
+fn running_bit() -> u16 {
+    let b = spec().family(FamilyId::Psd4xx).bitfield("status").unwrap();
+    1 << b
+        .bits
+        .iter()
+        .find(|x| x.name == "Drive is running")
         .unwrap()
         .bit
 }
@@ -126,6 +297,9 @@ impl CyclicDevice<'static> for Variant {
                 self.reached_since = None;
             }
         }
+        if let Kind::Shaft(filter) = self.kind {
+            self.shaft_input(filter, now, &rules, &mut input);
+        }
         if self.kind == Kind::OwnValues
             && input.pkw.ak != rules.pkw().response_codes().cannot_execute
             && input.pkw.ak != rules.pkw().response_codes().no_response
@@ -163,7 +337,20 @@ impl CyclicDevice<'static> for Variant {
     }
 
     fn env(&mut self, now: Micros, env: Env) -> bool {
-        self.drive.env(now, env)
+        let env = match (self.kind, env) {
+            (Kind::UmotAtLimit(by), Env::MotorVoltage(v))
+                if self.drive.parameter(90).ok() == Some(i64::from(v)) =>
+            {
+                Env::MotorVoltage(v.saturating_add_signed(by))
+            }
+            (_, e) => e,
+        };
+        let taken = self.drive.env(now, env);
+        if matches!(self.kind, Kind::Shaft(_)) {
+            let i = self.drive.input();
+            self.shaft.snap(f64::from(i.actual), f64::from(i.speed));
+        }
+        taken
     }
 
     fn clone_box(&self) -> Box<dyn CyclicDevice<'static>> {
@@ -180,6 +367,16 @@ pub fn variants() -> Vec<(&'static str, Kind)> {
         ("start latency 30 ms", Kind::StartLatency(30_000)),
         ("bit 0 10 ms after arrival", Kind::ReachedLater(10_000)),
         ("save answered after 900 ms", Kind::SlowSave(900_000)),
+        ("save answered after 1 s", Kind::SlowSave(1_000_000)),
+        ("S-curve (mean over 50 ms)", Kind::Shaft(Filter::Mean(5))),
+        ("braking tail 22 ms", Kind::Shaft(Filter::Lag(22_000))),
+        ("braking tail 18 ms", Kind::Shaft(Filter::Lag(18_000))),
+        ("U_mot at the limit counts as above", Kind::UmotAtLimit(1)),
+        ("U_mot at the limit counts as below", Kind::UmotAtLimit(-1)),
+        (
+            "par 38 writable while running",
+            Kind::Reading("par38-standstill", "par-39-only"),
+        ),
         ("identity and measurements of its own", Kind::OwnValues),
     ]
 }
