@@ -168,10 +168,8 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
             )?;
             for c in &r.coverage_summary {
                 say!(
-                    "coverage {}: {} of {} must requirements checked",
-                    c.family,
-                    c.checked,
-                    c.must
+                    "coverage {}: {} of {} must requirements checked, {} not observable over the interface",
+                    c.family, c.checked, c.must, c.not_observable
                 )?;
             }
             for w in &summary.written {

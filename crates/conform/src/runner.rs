@@ -475,13 +475,16 @@ fn build_report(
             family: s.family(),
             must: 0,
             checked: 0,
+            not_observable: 0,
         };
         for req in &family.requirements {
             let row = coverage_row(req, s.cases(), &cases);
             if req.level == Level::Must {
                 must.must += 1;
-                if matches!(row.verdict, Coverage::Pass | Coverage::Fail) {
-                    must.checked += 1;
+                match row.verdict {
+                    Coverage::Pass | Coverage::Fail => must.checked += 1,
+                    Coverage::NotObservable => must.not_observable += 1,
+                    Coverage::NotRun | Coverage::Untested => {}
                 }
             }
             if req.level == Level::Informative && row.cases.is_empty() {
@@ -549,7 +552,9 @@ fn coverage_row(req: &Requirement, suite: &[CaseInfo], results: &[CaseReport]) -
         let ran = refs
             .iter()
             .any(|r| !matches!(r.status, Status::Skipped | Status::NotRun));
-        let verdict = if refs.is_empty() || ran {
+        let verdict = if !req.observable {
+            Coverage::NotObservable
+        } else if refs.is_empty() || ran {
             Coverage::Untested
         } else {
             Coverage::NotRun

@@ -1,8 +1,9 @@
 //! Requirement coverage gate, counted from checks that evaluated: `drivespec conform all` runs
 //! on the built-in models and each case reports the requirements its judged steps checked
-//! (`CaseRun::checked`). Every `must` requirement of every family is checked, or listed in
-//! `tests/unchecked-<family>.toml` with a reason (rustls `bogo/config.json.in` style: no
-//! exclusion without a reason).
+//! (`CaseRun::checked`). Every `must` requirement of every family is checked, or marked
+//! `observable = false` in the spec with the reason no check can see it over the interface, or
+//! listed in `tests/unchecked-<family>.toml` with a reason (rustls `bogo/config.json.in` style:
+//! no exclusion without a reason).
 //!
 //! The lists only shrink: an entry whose requirement is checked by now, is unknown or is not
 //! `must` fails the gate as stale, and a checked requirement that stops being checked fails it
@@ -105,18 +106,21 @@ fn every_must_requirement_is_checked_or_listed_with_a_reason() {
             .iter()
             .map(|e| (e.id.as_str(), e.reason.as_str()))
             .collect();
+        let unobservable = must.iter().filter(|r| !r.observable).count();
         let unchecked: Vec<_> = must
             .iter()
-            .filter(|r| !checked.contains(r.id.as_str()))
+            .filter(|r| r.observable && !checked.contains(r.id.as_str()))
             .collect();
         let n = must.len();
-        let k = n - unchecked.len();
+        let k = n - unchecked.len() - unobservable;
+        let observable = n - unobservable;
         println!(
-            "  {family}: {k}/{n} must requirements checked ({:.1}%), {} listed as unchecked",
-            if n == 0 {
+            "  {family}: {k}/{n} must requirements checked ({:.1}% of the {observable} observable), \
+             {unobservable} not observable, {} listed as unchecked",
+            if observable == 0 {
                 100.0
             } else {
-                100.0 * k as f64 / n as f64
+                100.0 * k as f64 / observable as f64
             },
             unchecked.len()
         );
@@ -150,6 +154,10 @@ fn every_must_requirement_is_checked_or_listed_with_a_reason() {
             match must.iter().find(|r| r.id == e.id) {
                 None => problems.push(format!(
                     "{family}: {} is listed but is not a must requirement",
+                    e.id
+                )),
+                Some(r) if !r.observable => problems.push(format!(
+                    "{family}: {} is listed but the spec marks it not observable: remove the entry",
                     e.id
                 )),
                 Some(r) if checked.contains(r.id.as_str()) => problems.push(format!(

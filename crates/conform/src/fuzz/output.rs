@@ -196,6 +196,7 @@ pub(crate) fn build(
             .iter()
             .filter(|r| matches!(r.verdict, Coverage::Pass | Coverage::Fail))
             .count(),
+        not_observable: 0,
     }];
     Report {
         schema: report::SCHEMA,

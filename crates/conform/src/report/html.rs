@@ -72,10 +72,11 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
     for c in &r.coverage_summary {
         let _ = writeln!(
             h,
-            "<p>coverage {}: {} of {} <code>must</code> requirements checked</p>",
+            "<p>coverage {}: {} of {} <code>must</code> requirements checked, {} not observable over the interface</p>",
             escape(&c.family.to_string()),
             c.checked,
-            c.must
+            c.must,
+            c.not_observable
         );
     }
     h.push_str(extra);
@@ -86,6 +87,7 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
             Coverage::Fail => "fail",
             Coverage::NotRun => "not-run",
             Coverage::Untested => "untested",
+            Coverage::NotObservable => "not-observable",
         };
         let cases: Vec<String> = row
             .cases

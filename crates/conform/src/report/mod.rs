@@ -180,6 +180,8 @@ pub enum Coverage {
     NotRun,
     /// No check evaluated it (cases may cite it).
     Untested,
+    /// No check can evaluate it over the interface (spec `observable = false`, with the reason).
+    NotObservable,
 }
 
 /// How many of a family's `must` requirements a check evaluated in the run.
@@ -191,6 +193,8 @@ pub struct FamilyCoverage {
     pub must: usize,
     /// Those a check evaluated.
     pub checked: usize,
+    /// Those no check can evaluate over the interface (spec `observable = false`).
+    pub not_observable: usize,
 }
 
 /// One row of the coverage matrix.
