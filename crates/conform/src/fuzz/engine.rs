@@ -82,6 +82,8 @@ pub(crate) struct Found {
     pub(crate) start: Start,
     /// Times the signature was seen.
     pub(crate) occurrences: u64,
+    /// The wall-clock budget ended the minimisation: the steps are as far as it got.
+    pub(crate) cut_short: bool,
 }
 
 /// Limits of a campaign.
@@ -113,6 +115,7 @@ pub(crate) fn campaign(
     on_event: &mut dyn FnMut(Event<'_>),
 ) -> Vec<Found> {
     let started = std::time::Instant::now();
+    let deadline = limits.duration.map(|d| started + d);
     let caps = target.caps();
     let mut rng = Rng::new(seed);
     let mut found: Vec<Found> = Vec::new();
@@ -200,6 +203,7 @@ pub(crate) fn campaign(
                 limits.minimize_runs,
                 n,
                 &trial,
+                deadline,
             );
             stats.minimisation_runs += f.runs;
             match known {
@@ -276,7 +280,8 @@ fn same_fault(trial: &Trial, sig: &str) -> bool {
 /// then ddmin over the steps, over the bytes of each message, and over the steps again.
 /// Every run starts from the start state where the transport allows; the last run that
 /// showed the fault on the final sequence is its evidence (one more run confirms it if none
-/// did).
+/// did). No run starts after `deadline`: the steps are then as far as minimisation got.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn minimise(
     target: &mut dyn Target,
     steps: Vec<Step>,
@@ -285,13 +290,19 @@ pub(crate) fn minimise(
     max_runs: u64,
     sequence: u64,
     original: &Trial,
+    deadline: Option<std::time::Instant>,
 ) -> Found {
     let sig = fault.signature.clone();
     let original_steps = steps.len();
     let mut budget = max_runs;
     let mut start = Start::Fresh;
     let mut last: Option<(Vec<Step>, Trial)> = None;
+    let cut_short = std::cell::Cell::new(false);
     let mut check = |target: &mut dyn Target, cand: &[Step]| -> Option<Trial> {
+        if deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+            cut_short.set(true);
+            return None;
+        }
         match target.fresh() {
             Ok(s) => start = s,
             Err(_) => return None,
@@ -397,6 +408,7 @@ pub(crate) fn minimise(
         reproduced,
         start,
         occurrences: 1,
+        cut_short: cut_short.get(),
     }
 }
 

@@ -401,10 +401,10 @@ fn campaign(
                         f.fault.signature,
                         f.steps.len(),
                         f.original_steps,
-                        if f.reproduced {
-                            ""
-                        } else {
-                            ", did not reproduce from the start state"
+                        match (f.reproduced, f.cut_short) {
+                            (_, true) => ", minimisation stopped at the --duration limit",
+                            (true, false) => "",
+                            (false, false) => ", did not reproduce from the start state",
                         }
                     );
                     if let Some(file) = &finding.file {
@@ -625,6 +625,7 @@ fn minimize_with(
         opts.minimize_runs,
         sequence,
         &trial,
+        opts.duration.map(|d| std::time::Instant::now() + d),
     );
     let mut out = replay_of(&found, family, &opts.dut.to_string(), settings);
     if let (Some(new), Some(old)) = (out.finding.as_mut(), r.finding.as_ref()) {
