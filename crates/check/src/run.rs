@@ -291,6 +291,9 @@ pub fn check_path(
     let catalog = Arc::new(Catalog::new(spec).map_err(SetupError::from)?);
     let mut notes = Vec::new();
     let (rest, total, start) = open(path)?;
+    if start.is_empty() {
+        return Err(unreadable(path, "empty: nothing to check"));
+    }
     let plan = plan(path, &start, options, &mut notes)?;
     let count = Rc::new(Cell::new(0u64));
     let reader = BufReader::with_capacity(

@@ -485,3 +485,19 @@ fn a_device_that_never_answers_stops_the_run_as_a_set_up_error() {
         "drivespec: the device under test answered nothing in the first 10 cases (exec:sleep 600): check --dut, the bit rate and --address\n"
     );
 }
+
+#[test]
+fn an_empty_recording_is_nothing_to_check() {
+    let dir = temp_dir("hostile", "empty");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("empty.pcap");
+    std::fs::write(&file, b"").unwrap();
+    let (code, stdout, stderr) = run(BIN, &["check", file.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 2, "{stdout}{stderr}");
+    assert!(
+        stderr.ends_with("empty.pcap: empty: nothing to check\n"),
+        "{stderr}"
+    );
+    assert!(!stdout.contains("PASS"), "{stdout}");
+}
