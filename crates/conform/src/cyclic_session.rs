@@ -31,6 +31,29 @@ pub(crate) struct Tolerance {
     pub motion: bool,
 }
 
+/// A live quantity an acyclic read reports, as the input image carries it too.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Live {
+    /// Actual position.
+    Position,
+    /// Actual speed.
+    Speed,
+}
+
+/// A live value read during a motion case, judged once the cycles after it are known.
+struct LiveRead {
+    /// Its evidence record.
+    record: usize,
+    /// Its step.
+    step: usize,
+    /// The number of cycles before the read.
+    cycle: usize,
+    /// What it reports.
+    quantity: Live,
+    /// The value read.
+    value: i64,
+}
+
 /// Whether both replies carry data of the same length: how a read of a device's own value
 /// (spec `per_device`: serial number, version, a measurement) is judged.
 pub(crate) fn same_length(expected: &Reply, got: &Reply) -> Option<String> {
@@ -41,6 +64,9 @@ pub(crate) fn same_length(expected: &Reply, got: &Reply) -> Option<String> {
         _ => None,
     }
 }
+
+/// The evidence note of a live value read in a motion case.
+const LIVE_NOTE: &str = "live value: within the device's own input images around the read";
 
 /// How much faster than the reference's highest speed a device may move in a motion case, %:
 /// the reference runs at the limit in force, a device's speed reading may round differently.
@@ -105,6 +131,32 @@ pub(crate) enum Op<O> {
     Advance(u64),
     /// A request between two cycles, judged by its reply.
     Exchange(Request),
+    /// A read repeated once a cycle (at that cycle's time) while the device's reply does not
+    /// yet conform to the reference's, at most `max` cycles; judged by the last reply. A state
+    /// the manual lets last a bounded time (PSx3xx 3.1: ISDU 193 reads ≠ 0 while a save runs,
+    /// "saving can take up to 2000ms").
+    Poll {
+        /// The read.
+        req: Request,
+        /// Most cycles.
+        max: u32,
+    },
+}
+
+/// `req` with its time set to `t` (requests without a time unchanged).
+fn at_time(req: &Request, t: u64) -> Request {
+    let mut req = req.clone();
+    match &mut req {
+        Request::Hello { .. } | Request::Reset => {}
+        Request::Cycle { t: x, .. }
+        | Request::Advance { t: x }
+        | Request::Read { t: x, .. }
+        | Request::Write { t: x, .. }
+        | Request::IsduRead { t: x, .. }
+        | Request::IsduWrite { t: x, .. }
+        | Request::Env { t: x, .. } => *x = t,
+    }
+    req
 }
 
 /// What a cyclic family's session needs from the family: its reference, images, steps and
@@ -181,6 +233,12 @@ pub(crate) trait CyclicFamily<'s> {
         got: &Reply,
         tol: Tolerance,
     ) -> (bool, Option<String>);
+    /// For a read of a live value in a motion case (actual position, speed): which quantity
+    /// of [`CyclicFamily::motion`] the reply carries and its value. Such a read is judged
+    /// against the device's own input images around it, not against the reference's run.
+    fn live(&self, _req: &Request, _got: &Reply) -> Option<(Live, i64)> {
+        None
+    }
     /// What `action` does, given the current output, the reference's last input and the time.
     fn op(
         &self,
@@ -461,6 +519,8 @@ struct Run<'r, 's, I, O> {
     arrivals: Vec<usize>,
     /// The point the manual leaves open ([`CyclicFamily::open`]).
     open: Option<OpenPoint>,
+    /// Live values read in a motion case.
+    live: Vec<LiveRead>,
 }
 
 impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
@@ -554,9 +614,23 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 (None, format!("error: {e}"))
             }
         };
-        let (ok, remark) = match &got {
-            Some(g) => self.family.same_reply(&req, &expected, g, run.tol),
-            None => (false, None),
+        let live = got
+            .as_ref()
+            .filter(|g| run.tol.motion && same_length(&expected, g).is_some())
+            .and_then(|g| self.family.live(&req, g));
+        let (ok, remark) = match (&got, live) {
+            (Some(_), Some((quantity, value))) => {
+                run.live.push(LiveRead {
+                    record: run.evidence.len(),
+                    step,
+                    cycle: run.cycles.len(),
+                    quantity,
+                    value,
+                });
+                (true, Some(LIVE_NOTE.to_owned()))
+            }
+            (Some(g), None) => self.family.same_reply(&req, &expected, g, run.tol),
+            (None, _) => (false, None),
         };
         run.evidence.push(Record {
             step,
@@ -588,6 +662,16 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             });
         }
         ok
+    }
+
+    /// Whether the device's reply to the read `req` conforms to the reference's now (a probe of
+    /// [`Op::Poll`], not recorded; a transport failure ends the polling).
+    fn conforms(&mut self, run: &mut Run<'_, 's, F::Input, F::Output>, req: &Request) -> bool {
+        let expected = run.reference.handle(req.clone());
+        match self.device.call(req) {
+            Ok(got) => self.family.same_reply(req, &expected, &got, run.tol).0,
+            Err(_) => true,
+        }
     }
 
     fn run_steps(
@@ -639,10 +723,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                             }
                         }
                         if reference.done() && device.done() {
+                            run.arrivals.push(run.cycles.len());
                             break;
                         }
                     }
-                    run.arrivals.push(run.cycles.len());
                 }
                 Op::Advance(us) => {
                     run.t = run.t.saturating_add(us);
@@ -654,6 +738,18 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 }
                 Op::Exchange(req) => {
                     if !self.exact(run, n, s.role, &s.text, req) {
+                        return Ok(());
+                    }
+                    continue;
+                }
+                Op::Poll { req, max } => {
+                    for _ in 0..max {
+                        if self.conforms(run, &at_time(&req, run.t)) {
+                            break;
+                        }
+                        self.cycle(run, n)?;
+                    }
+                    if !self.exact(run, n, s.role, &s.text, at_time(&req, run.t)) {
                         return Ok(());
                     }
                     continue;
@@ -707,6 +803,55 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         Ok(())
     }
 
+    /// Every live value read in a motion case lies between the device's own input images of
+    /// the cycles before and after the read, widened by the case's tolerance; a record that
+    /// does not is marked and is the failure unless one came first.
+    fn judge_live(&self, run: &mut Run<'_, 's, F::Input, F::Output>, tol: Tolerance) {
+        for l in std::mem::take(&mut run.live) {
+            let around: Vec<i64> = [l.cycle.checked_sub(1), Some(l.cycle)]
+                .into_iter()
+                .flatten()
+                .filter_map(|i| run.cycles.get(i))
+                .filter_map(|c| c.dut.as_ref().ok())
+                .map(|d| {
+                    let (position, speed, _) = F::motion(d);
+                    match l.quantity {
+                        Live::Position => position,
+                        Live::Speed => speed,
+                    }
+                })
+                .collect();
+            let slack = match l.quantity {
+                Live::Position => tol.position,
+                Live::Speed => tol.speed,
+            };
+            let (Some(lo), Some(hi)) = (around.iter().min(), around.iter().max()) else {
+                continue;
+            };
+            let (lo, hi) = (lo.saturating_sub(slack), hi.saturating_add(slack));
+            if (lo..=hi).contains(&l.value) {
+                continue;
+            }
+            let allowed = format!("{lo}…{hi} (the device's own input images around the read)");
+            if let Some(r) = run.evidence.get_mut(l.record) {
+                r.ok = Some(false);
+                r.note = Some(format!("{LIVE_NOTE}: {allowed}"));
+            }
+            if run.failure.is_none() {
+                run.failure = Some(Failure {
+                    step: Some(l.step),
+                    message: format!(
+                        "step {}: the live value read differs from the device's own process data",
+                        l.step
+                    ),
+                    expected: allowed,
+                    got: l.value.to_string(),
+                    requirements: self.refs(run.reqs),
+                });
+            }
+        }
+    }
+
     /// Judges the cycles under `tol`; marks the records and sets the first failure.
     fn judge(&self, run: &mut Run<'_, 's, F::Input, F::Output>, tol: Tolerance) {
         let device: Vec<Option<F::Input>> = run
@@ -720,6 +865,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 *d = j;
             }
         }
+        self.judge_live(run, tol);
         let bad_steps = if tol.motion {
             self.judge_motion(run, tol)
         } else {
@@ -817,11 +963,24 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         let mut bounds = vec![0];
         bounds.extend(run.arrivals.iter().copied());
         bounds.push(run.cycles.len());
+        // A case that ends while the device still moves is judged up to where the device has
+        // got: in its last segment the device's changes must begin the reference's, the rest
+        // may come after the end (a drive may react later than the reference).
+        let moving_at_end = run
+            .cycles
+            .last()
+            .and_then(|c| c.dut.as_ref().ok())
+            .is_some_and(|d| {
+                let (_, speed, status) = F::motion(d);
+                speed != 0 || status & running != 0
+            });
+        let end = run.cycles.len();
         for w in bounds.windows(2) {
             let (from, to) = match w {
                 [a, b] if a < b => (*a, *b),
                 _ => continue,
             };
+            let open = moving_at_end && to == end;
             let segment = run.cycles.get(from..to).unwrap_or(&[]);
             let before = from.checked_sub(1).and_then(|i| run.cycles.get(i));
             let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
@@ -839,7 +998,9 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     |i| F::motion(i).2 & mask != 0,
                     |_| false,
                     (mask == running).then_some(true),
-                ) {
+                )
+                .filter(|x| !(open && x.device.is_none()))
+                {
                     bad.push(Finding::at(
                         x.at,
                         run.cycles.get(x.at).map_or(0, |c| c.step),
@@ -869,7 +1030,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 |v| *v == 0,
                 None,
             )
-            .filter(|_| !movement_open)
+            .filter(|x| !movement_open && !(open && x.device.is_none()))
             {
                 bad.push(Finding::at(
                     x.at,
@@ -1124,6 +1285,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             reqs: &info.requirements,
             arrivals: Vec::new(),
             open: F::open(case),
+            live: Vec::new(),
         };
         let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),

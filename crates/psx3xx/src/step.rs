@@ -60,6 +60,19 @@ pub enum Step {
         #[serde(default)]
         subindex: u8,
     },
+    /// An ISDU read repeated once a cycle until it answers as a finished device does, at most
+    /// `max` cycles (3.1 ISDU 193: "≠ 0 → Save is still running … (saving can take up to
+    /// 2000ms)"; 5.5 comment 8: "As soon as the reading of ISDU 193 returns a 0, the save is
+    /// finished").
+    IsduPoll {
+        /// ISDU index.
+        index: u16,
+        /// Sub-index.
+        #[serde(default)]
+        subindex: u8,
+        /// Most cycles.
+        max: u32,
+    },
     /// An ISDU write between two cycles, most significant octet first (3.1).
     IsduWrite {
         /// ISDU index.
@@ -115,6 +128,7 @@ impl Step {
             Step::Until { .. } => "until",
             Step::Advance { .. } => "advance",
             Step::IsduRead { .. } => "isdu-read",
+            Step::IsduPoll { .. } => "isdu-poll",
             Step::IsduWrite { .. } => "isdu-write",
             Step::Env { .. } => "env",
         }

@@ -851,13 +851,7 @@ impl<'a, 's> Gen<'a, 's> {
                 self.read(&g.guard),
                 self.write(Role::Check, &g.guard, allow_value),
                 self.save(Role::Check),
-                Some(step(
-                    Role::Check,
-                    "saving",
-                    Step::Hold {
-                        cycles: self.cycles_for(self.save_ms()),
-                    },
-                )),
+                self.saved(Role::Check),
                 Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                 self.read(&g.guard),
             ]
@@ -893,6 +887,25 @@ impl<'a, 's> Gen<'a, 's> {
             return None;
         };
         self.write(role, isdu::DELIVERY_STATE, value)
+    }
+
+    /// ISDU 193 read once a cycle until it reads 0, within the longest save (3.1: "≠ 0 →
+    /// Save is still running … (saving can take up to 2000ms)"; 5.5 comment 8).
+    fn saved(&mut self, role: Role) -> Option<StepDef> {
+        let p = self.param(isdu::DELIVERY_STATE)?;
+        let (index, subindex) = address(p)?;
+        Some(step(
+            role,
+            format!(
+                "ISDU read {index} until the save is finished (0), at most {} ms",
+                self.save_ms()
+            ),
+            Step::IsduPoll {
+                index,
+                subindex,
+                max: self.cycles_for(self.save_ms()),
+            },
+        ))
     }
 
     fn save_ms(&self) -> u64 {
@@ -959,15 +972,18 @@ impl<'a, 's> Gen<'a, 's> {
             );
             steps.extend(self.device_id_reads());
             let reqs: Vec<&str> = reqs.iter().map(String::as_str).collect();
-            self.case(
-                &format!("command/{}/{}", c.param, c.name),
-                &reqs,
-                &format!(
-                    "ISDU {} = {} ({}): {}; working and saved values across a power cycle",
-                    c.param, c.value, c.name, c.meaning
-                ),
-                steps,
+            let id = format!("command/{}/{}", c.param, c.name);
+            let description = format!(
+                "ISDU {} = {} ({}): {}; working and saved values across a power cycle",
+                c.param, c.value, c.name, c.meaning
             );
+            // A command that moves the drive (reference loop, mid-range run) is judged by
+            // the properties of the run (4.2, 5.14), not cycle by cycle.
+            if c.reference_loop || c.centre_run {
+                self.motion(&id, &reqs, &description, steps);
+            } else {
+                self.case(&id, &reqs, &description, steps);
+            }
         }
         // Values that are not commands: 0, the type's top, one above each command and one
         // beyond each end of ISDU 193's range.
@@ -1036,15 +1052,7 @@ impl<'a, 's> Gen<'a, 's> {
         let kept: Vec<StepDef> = [
             self.write(Role::Check, probe, probe_value),
             self.save(Role::Check),
-            self.read(isdu::DELIVERY_STATE),
-            Some(step(
-                Role::Check,
-                "saving",
-                Step::Hold {
-                    cycles: save_cycles,
-                },
-            )),
-            self.read(isdu::DELIVERY_STATE),
+            self.saved(Role::Check),
             Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
             self.read(probe),
         ]
@@ -1076,13 +1084,7 @@ impl<'a, 's> Gen<'a, 's> {
             let steps: Vec<StepDef> = [
                 self.write(Role::Check, &p.id, v),
                 self.save(Role::Check),
-                Some(step(
-                    Role::Check,
-                    "saving",
-                    Step::Hold {
-                        cycles: save_cycles,
-                    },
-                )),
+                self.saved(Role::Check),
                 Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
                 self.read(&p.id),
             ]
@@ -1126,7 +1128,6 @@ impl<'a, 's> Gen<'a, 's> {
     /// Steps that make `format` the active one: write, save, device reset (PSX-PD-010).
     fn switch_to(&mut self, format: u8, role: Role) -> Vec<StepDef> {
         let param = self.rules.protocol().format_select.param.clone();
-        let save_cycles = self.cycles_for(self.save_ms());
         let reset = self
             .rules
             .protocol()
@@ -1142,13 +1143,7 @@ impl<'a, 's> Gen<'a, 's> {
         let mut steps: Vec<StepDef> = [
             self.write(role, &param, i64::from(format)),
             self.save(role),
-            Some(step(
-                role,
-                "saving",
-                Step::Hold {
-                    cycles: save_cycles,
-                },
-            )),
+            self.saved(role),
             self.write(role, &reset_param, reset_value),
         ]
         .into_iter()

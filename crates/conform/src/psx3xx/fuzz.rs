@@ -94,7 +94,10 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
         // The motion cases' tolerance as soon as anything may move the drive; the ISDU
         // cases' (exact) otherwise.
         let moves = own.iter().any(|a| match a {
-            PsxStep::IsduRead { .. } | PsxStep::Hold { .. } | PsxStep::Advance { .. } => false,
+            PsxStep::IsduRead { .. }
+            | PsxStep::IsduPoll { .. }
+            | PsxStep::Hold { .. }
+            | PsxStep::Advance { .. } => false,
             PsxStep::IsduWrite { index, .. } => self.moving.contains(index),
             _ => true,
         });
@@ -172,7 +175,9 @@ fn idle(suite: &Psx3xxSuite<'_>, format: u8) -> Output {
 fn kind(s: &PsxStep) -> String {
     match s {
         PsxStep::PdOut { format, .. } => format!("pd-format-{format}"),
-        PsxStep::IsduRead { index, .. } => format!("isdu-read-{index}"),
+        PsxStep::IsduRead { index, .. } | PsxStep::IsduPoll { index, .. } => {
+            format!("isdu-read-{index}")
+        }
         PsxStep::IsduWrite { index, .. } => format!("isdu-write-{index}"),
         PsxStep::Env { env } => cyclic_target::env_signature(env),
         other => other.name().to_owned(),
@@ -192,6 +197,15 @@ fn bounded(s: &PsxStep) -> PsxStep {
         },
         PsxStep::Advance { us } => PsxStep::Advance {
             us: (*us).min(cyclic_target::MAX_ADVANCE_US),
+        },
+        PsxStep::IsduPoll {
+            index,
+            subindex,
+            max,
+        } => PsxStep::IsduPoll {
+            index: *index,
+            subindex: *subindex,
+            max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
         },
         other => other.clone(),
     }

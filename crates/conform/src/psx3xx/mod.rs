@@ -18,7 +18,8 @@
 //!
 //! Every cycle's input image is compared with the reference's: status word exactly, position
 //! and speed within the case's declared tolerance; every ISDU and injection reply exactly,
-//! except the live speed and position read by ISDU, which get the same tolerance.
+//! except the live speed and position read by ISDU in a motion case, which must lie between
+//! the device's own process-data images around the read (within the case's tolerance).
 
 pub(crate) mod cases;
 pub(crate) mod fuzz;

@@ -6,7 +6,7 @@ use super::Psx3xxSuite;
 use crate::case::CaseInfo;
 use crate::cyclic::WireError;
 use crate::cyclic::{Reply, Request, Server};
-use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
+use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Live, Op, Tolerance};
 use drivespec_psx3xx::isdu::ErrorType;
 use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
@@ -21,18 +21,9 @@ pub(crate) type Psx3xxSession<'a, 's> = CyclicSession<'a, Psx3xx<'a, 's>>;
 pub(crate) struct Psx3xx<'a, 's> {
     suite: &'a Psx3xxSuite<'s>,
     running_bit: u16,
-    /// ISDU indices of the live speed and position (3.3.2 `rpm`, `actual`), judged within
-    /// the case's speed and position tolerance.
+    /// ISDU indices of the live speed and position (3.3.2 `rpm`, `actual`), judged in a
+    /// motion case against the device's own process data.
     live: Vec<(u16, Live)>,
-}
-
-/// Which tolerance a live ISDU value gets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Live {
-    /// Actual speed (ISDU 65).
-    Speed,
-    /// Actual position (ISDU 67).
-    Position,
 }
 
 /// The status bit the runner waits on (manual 3.4 bit 6).
@@ -112,45 +103,6 @@ impl<'a, 's> Psx3xx<'a, 's> {
             accepted,
             accepted.then(|| format!("ErrorType {g} accepted for {e}")),
         )
-    }
-
-    /// A live value read by ISDU (speed, position) within the case's tolerance: both replies
-    /// `DATA` of the same width, signed, most significant octet first.
-    fn live_within(
-        &self,
-        req: &Request,
-        expected: &Reply,
-        got: &Reply,
-        tol: Tolerance,
-    ) -> Option<String> {
-        let Request::IsduRead {
-            index, subindex: 0, ..
-        } = req
-        else {
-            return None;
-        };
-        let (_, kind) = self.live.iter().find(|(i, _)| i == index)?;
-        let (Reply::Data(e), Reply::Data(g)) = (expected, got) else {
-            return None;
-        };
-        let signed = |b: &[u8]| -> Option<i64> {
-            if b.is_empty() || b.len() > 8 {
-                return None;
-            }
-            let first = i64::from(i8::from_ne_bytes([*b.first()?]));
-            Some(
-                b.iter()
-                    .skip(1)
-                    .fold(first, |a, x| (a << 8) | i64::from(*x)),
-            )
-        };
-        let (ev, gv) = (signed(e)?, signed(g)?);
-        let limit = match kind {
-            Live::Speed => tol.speed,
-            Live::Position => tol.position,
-        };
-        (e.len() == g.len() && (ev - gv).abs() <= limit && limit > 0)
-            .then(|| format!("live value within ±{limit}"))
     }
 }
 
@@ -265,14 +217,13 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
     }
 
     /// The reference's reply exactly, or for an ISDU error the same ErrorType (named or hex)
-    /// or one the spec's cases with that ErrorType accept (IEC 61131-9 C.2); a live value
-    /// within the case's tolerance.
+    /// or one the spec's cases with that ErrorType accept (IEC 61131-9 C.2).
     fn same_reply(
         &self,
         req: &Request,
         expected: &Reply,
         got: &Reply,
-        tol: Tolerance,
+        _tol: Tolerance,
     ) -> (bool, Option<String>) {
         if let Request::IsduRead { index, .. } = req {
             let own = self
@@ -304,13 +255,31 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
                 }
             }
         }
-        match self.error_type_match(expected, got) {
-            (false, _) => match self.live_within(req, expected, got, tol) {
-                Some(note) => (true, Some(note)),
-                None => (false, None),
-            },
-            same => same,
+        self.error_type_match(expected, got)
+    }
+
+    /// A read of ISDU 65 or 67 (sub-index 0) answered with data: signed, most significant
+    /// octet first (3.1).
+    fn live(&self, req: &Request, got: &Reply) -> Option<(Live, i64)> {
+        let Request::IsduRead {
+            index, subindex: 0, ..
+        } = req
+        else {
+            return None;
+        };
+        let (_, kind) = self.live.iter().find(|(i, _)| i == index)?;
+        let Reply::Data(b) = got else {
+            return None;
+        };
+        if b.is_empty() || b.len() > 8 {
+            return None;
         }
+        let first = i64::from(i8::from_ne_bytes([*b.first()?]));
+        let value = b
+            .iter()
+            .skip(1)
+            .fold(first, |a, x| (a << 8) | i64::from(*x));
+        Some((*kind, value))
     }
 
     fn op(&self, action: &Step, _out: &Output, _last: Option<&Input>, t: u64) -> Op<Output> {
@@ -336,6 +305,18 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
                 index: *index,
                 subindex: *subindex,
             }),
+            Step::IsduPoll {
+                index,
+                subindex,
+                max,
+            } => Op::Poll {
+                req: Request::IsduRead {
+                    t,
+                    index: *index,
+                    subindex: *subindex,
+                },
+                max: *max,
+            },
             Step::IsduWrite {
                 index,
                 subindex,

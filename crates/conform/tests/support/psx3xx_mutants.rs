@@ -47,6 +47,8 @@ pub enum Kind {
     CommandValueAccepted,
     /// Control bit 14 (clear error bits) is ignored.
     ClearErrorsIgnored,
+    /// Status bits 14 and 15 (positive and negative range limit) swapped.
+    LimitBitsSwapped,
     /// Not a deviation: out-of-range writes answered with PAR_VALGTLIM as hex, an ErrorType
     /// the spec accepts for them (IEC 61131-9 C.2.10).
     AcceptableVariant,
@@ -179,6 +181,18 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
         let mut input = last.unwrap_or_else(|| self.drive.input());
         if self.kind == Kind::TemperatureBitMissing {
             input.status &= !status_bit(&self.drive, "Temperature exceeded");
+        }
+        if self.kind == Kind::LimitBitsSwapped {
+            let up = status_bit(&self.drive, "Positive range limit");
+            let down = status_bit(&self.drive, "Negative range limit");
+            let (u, d) = (input.status & up != 0, input.status & down != 0);
+            input.status &= !(up | down);
+            if u {
+                input.status |= down;
+            }
+            if d {
+                input.status |= up;
+            }
         }
         input.to_bytes(&rules, order).map_err(|e| e.to_string())
     }
@@ -423,6 +437,12 @@ pub fn mutants() -> Vec<Case> {
             name: "ISDU 2 accepts values that are no command",
             must_fail: &["psx3xx/command/2/invalid-*"],
             breaks: &["PSX-DP-ERR-005"],
+        },
+        Case {
+            kind: Kind::LimitBitsSwapped,
+            name: "status bits 14 and 15 (range limits) swapped",
+            must_fail: &["psx3xx/status/upper-limit", "psx3xx/status/lower-limit"],
+            breaks: &["PSX-STS-14-*", "PSX-STS-15-*"],
         },
         Case {
             kind: Kind::ClearErrorsIgnored,

@@ -1,6 +1,7 @@
 //! PSx3xx legal variants: the reference drive changed only where the manual leaves the
 //! choice to the implementation (chapter 5 fixes no reaction time; 3.1 gives identification
-//! values as examples), as a second team's drive would behave.
+//! values as examples and lets a save take up to 2000 ms), as a second team's drive would
+//! behave.
 
 use super::mutants::spec;
 use drivespec_conform::cyclic::{CyclicDevice, Env, Reply};
@@ -20,6 +21,9 @@ pub enum Kind {
     StartLatency(Micros),
     /// Identification values (spec `per_device`) of its own.
     OwnValues,
+    /// A save to EEPROM takes this many µs; ISDU 193 reads 1 until it is finished (3.1: "≠ 0
+    /// → Save is still running").
+    SaveTime(Micros),
 }
 
 /// The reference drive with the freedom `kind` taken.
@@ -30,6 +34,8 @@ pub struct Variant<'s> {
     /// The output image in force and the images still to take effect (due, image).
     applied: Option<Vec<u8>>,
     pending: VecDeque<(Micros, Vec<u8>)>,
+    /// When the save in progress is finished.
+    saving_until: Option<Micros>,
 }
 
 impl Variant<'static> {
@@ -41,6 +47,7 @@ impl Variant<'static> {
             kind,
             applied: None,
             pending: VecDeque::new(),
+            saving_until: None,
         }
     }
 }
@@ -87,6 +94,18 @@ impl<'s> CyclicDevice<'s> for Variant<'s> {
     fn isdu(&mut self, now: Micros, req: Request) -> Reply {
         let (index, _) = req.address();
         let read = matches!(req, Request::Read { .. });
+        if let Kind::SaveTime(us) = self.kind {
+            let saving = self.saving_until.is_some_and(|end| now < end);
+            if read && saving && index == DELIVERY_STATE {
+                return Reply::Data(vec![0, 1]);
+            }
+            let save = self.saves(&req);
+            let reply = CyclicDevice::isdu(&mut self.drive, now, req);
+            if save && reply == Reply::Ok {
+                self.saving_until = Some(now.saturating_add(us));
+            }
+            return reply;
+        }
         match CyclicDevice::isdu(&mut self.drive, now, req) {
             Reply::Data(mut d) if self.kind == Kind::OwnValues && read && per_device(index) => {
                 // Another serial number, date or version: digits stay digits.
@@ -104,6 +123,9 @@ impl<'s> CyclicDevice<'s> for Variant<'s> {
     }
 
     fn env(&mut self, now: Micros, env: Env) -> bool {
+        if matches!(env, Env::PowerCycle) {
+            self.saving_until = None;
+        }
         CyclicDevice::env(&mut self.drive, now, env)
     }
 
@@ -112,7 +134,29 @@ impl<'s> CyclicDevice<'s> for Variant<'s> {
     }
 }
 
+/// ISDU 193: delivery state and save command (3.1).
+const DELIVERY_STATE: u16 = 193;
+
 impl Variant<'_> {
+    /// Whether `req` writes a command that saves to EEPROM (3.1 ISDU 2 = 161, ISDU 193).
+    fn saves(&self, req: &Request) -> bool {
+        let Request::Write { index, data, .. } = req else {
+            return false;
+        };
+        // Command values are signed (3.1: ISDU 193 -2…3, ±15 bit).
+        let signed = match data.as_slice() {
+            [a, b] => i64::from(i16::from_be_bytes([*a, *b])),
+            other => other.iter().fold(0i64, |a, b| (a << 8) | i64::from(*b)),
+        };
+        self.drive
+            .rules()
+            .protocol()
+            .commands
+            .commands
+            .iter()
+            .any(|c| c.save && c.param == index.to_string() && c.value == signed)
+    }
+
     /// The input while no output has taken effect yet: the drive as it stands.
     fn idle(&mut self, now: Micros) -> Result<Vec<u8>, String> {
         CyclicDevice::advance(&mut self.drive, now);
@@ -137,8 +181,11 @@ fn per_device(index: u16) -> bool {
 /// Every PSx3xx legal variant with its name.
 pub fn variants() -> Vec<(&'static str, Kind)> {
     vec![
+        ("start latency 1 ms", Kind::StartLatency(1_000)),
+        ("start latency 3 ms", Kind::StartLatency(3_000)),
         ("start latency 8 ms", Kind::StartLatency(8_000)),
         ("start latency 30 ms", Kind::StartLatency(30_000)),
         ("identification of its own", Kind::OwnValues),
+        ("a save takes 1.5 s", Kind::SaveTime(1_500_000)),
     ]
 }

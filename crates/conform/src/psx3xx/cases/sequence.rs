@@ -10,13 +10,21 @@ use drivespec_positioner::step::read_sequence;
 use drivespec_psd4xx::model::LinkEvent;
 use drivespec_psx3xx::isdu::Value;
 use drivespec_psx3xx::step::{
-    Event, IsduOp, IsduStep, Key, LoopSide, ProcessData, PsxSequence, Step, VectorStep,
+    Event, IsduOp, IsduStep, Key, LoopSide, ProcessData, PsxSequence, Run, Step, VectorStep,
 };
 use drivespec_psx3xx::{Output, Stamp, TsCode};
 use drivespec_spec::{Vector, VectorKind};
 
+/// The rule that a target speed of 0 in the 8-byte format runs at ISDU 142 (3.3.1).
+const SPEED_ZERO: &str = "PSX-VEL-006";
+
 /// ms the model tests of the vectors let pass after every step.
 const STEP_MS: u64 = 8;
+
+/// Longest wait, ms, for the start or the standstill a vector step leads to: longer than the
+/// start, stop or reversal of a run by a drive that reacts some cycles after the reference
+/// (chapter 5 fixes no reaction time), short enough not to run a long positioning to its end.
+const REACTION_MS: u64 = 1000;
 
 impl Gen<'_, '_> {
     /// One case per `sequence` vector that applies to the model, needs no property the master
@@ -44,7 +52,17 @@ impl Gen<'_, '_> {
                 }
             };
             if let Some(steps) = self.sequence_steps(&seq) {
-                let reqs = v.requirements.clone();
+                let mut reqs = v.requirements.clone();
+                // A run in the 8-byte format without a speed of its own runs at ISDU 142.
+                let own_speed = seq
+                    .input
+                    .steps
+                    .iter()
+                    .filter_map(|s| s.pd.as_ref())
+                    .all(|pd| pd.target_speed.unwrap_or(0) != 0);
+                if self.format_of(&seq) == 2 && !own_speed {
+                    reqs.push(SPEED_ZERO.to_owned());
+                }
                 let start = self.idle(self.rules.default_format());
                 self.push(
                     format!("psx3xx/sequence/{}", v.id),
@@ -59,6 +77,18 @@ impl Gen<'_, '_> {
                 );
             }
         }
+    }
+
+    /// The process-data format a vector runs in (its start state, else its `format`).
+    fn format_of(&self, seq: &PsxSequence) -> u8 {
+        let format_param = &self.rules.protocol().format_select.param;
+        seq.input
+            .state
+            .get(format_param)
+            .and_then(|v| v.int())
+            .and_then(|f| u8::try_from(f).ok())
+            .or(seq.input.format)
+            .unwrap_or(self.rules.default_format())
     }
 
     /// The case steps of a vector, None when it cannot be played through the bus.
@@ -89,13 +119,7 @@ impl Gen<'_, '_> {
         {
             return None;
         }
-        let format = input
-            .state
-            .get(&format_param)
-            .and_then(|v| v.int())
-            .and_then(|f| u8::try_from(f).ok())
-            .or(input.format)
-            .unwrap_or(self.rules.default_format());
+        let format = self.format_of(seq);
         let mut steps = Vec::new();
         if format != self.rules.default_format() {
             steps.extend(self.switch_to(format, Role::Setup));
@@ -118,10 +142,34 @@ impl Gen<'_, '_> {
             };
             steps.push(self.isdu_step(Role::Setup, "state", &write)?);
         }
+        // Whether the vector expects a run in progress before the step.
+        let mut moving = false;
         for (n, s) in input.steps.iter().enumerate() {
             let n = n.saturating_add(1);
-            self.sequence_step(&mut steps, n, s, format, loop_direction)?;
+            // A run is waited for where the next step's event is meant for the running drive.
+            let event_next = input.steps.get(n).is_some_and(|next| next.event.is_some());
+            self.sequence_step(
+                &mut steps,
+                n,
+                s,
+                format,
+                loop_direction,
+                !moving && event_next,
+            )?;
+            if let Some(run) = s.expect.run {
+                moving = run != Run::None;
+            }
         }
+        // Each side ends the vector's last step at its own pace; a run that goes on is judged
+        // up to the end of the wait.
+        steps.push(step(
+            Role::Check,
+            format!("until standstill, at most {REACTION_MS} ms"),
+            Step::Until {
+                running: false,
+                max: self.cycles_for(REACTION_MS),
+            },
+        ));
         steps.push(step(Role::Check, "settle", Step::Hold { cycles: SETTLE }));
         Some(steps)
     }
@@ -133,6 +181,7 @@ impl Gen<'_, '_> {
         s: &VectorStep,
         format: u8,
         loop_direction: i64,
+        await_run: bool,
     ) -> Option<()> {
         if let Some(key) = s.key {
             let (forward, reverse) = match key {
@@ -214,6 +263,31 @@ impl Gen<'_, '_> {
             }
         }
         let e = &s.expect;
+        // The standstill a step leads to, and a run it starts when the next step's event (an
+        // obstruction, a lost connection) is meant for the running drive, are waited for on
+        // each side: a drive may react later than the reference (chapter 5 fixes no reaction
+        // time).
+        // An event's own waits are above (an obstruction is removed once the drive stands).
+        let master = s.pd.is_some() || s.isdu.is_some();
+        let wait = |running: bool| Step::Until {
+            running,
+            max: self.cycles_for(REACTION_MS),
+        };
+        match e.run {
+            Some(Run::None) if master => steps.push(step(
+                Role::Check,
+                format!("step {n}: until standstill, at most {REACTION_MS} ms"),
+                wait(false),
+            )),
+            Some(r) if r != Run::None && (master || s.event.is_some()) && await_run => {
+                steps.push(step(
+                    Role::Check,
+                    format!("step {n}: until running, at most {REACTION_MS} ms"),
+                    wait(true),
+                ))
+            }
+            _ => {}
+        }
         let ms = e.after_us.map_or(0, |us| us / 1000 + 1)
             + s.hold_ms.or(e.after_ms).unwrap_or(0)
             + if e.stop == Some(false) { 50 } else { 0 }
