@@ -1030,7 +1030,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 |v| *v == 0,
                 None,
             )
-            .filter(|x| !movement_open && !(open && x.device.is_none()))
+            .filter(|x| !(movement_open || (open && x.device.is_none())))
             {
                 bad.push(Finding::at(
                     x.at,
