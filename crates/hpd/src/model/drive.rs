@@ -51,6 +51,29 @@ pub struct Drive {
 }
 
 impl Drive {
+    /// This drive's state (values, program, line, clock) under the erratum readings `other`
+    /// was built with (spec `[[erratum]]` options): what the same history would be on a drive
+    /// following those readings as long as they did not tell apart so far.
+    pub fn under_readings_of(&self, other: &Drive) -> Drive {
+        let mut d = self.clone();
+        d.layout = Arc::clone(&other.layout);
+        d.command_seen.resize(d.layout.commands.len(), false);
+        d
+    }
+
+    /// The PLC scan grid (and the FIN slots) moved `by` µs later: the same drive with its
+    /// scans at another phase against the line (3.8.1 fixes the 6.144 ms period, not when a
+    /// scan falls between two messages).
+    pub fn shift_scan(&mut self, by: Micros) {
+        self.epoch = self.epoch.saturating_add(by);
+        self.next_scan = self.next_scan.map(|t| t.saturating_add(by));
+    }
+
+    /// The PLC scan period (3.8.1, µs).
+    pub fn scan_period(&self) -> Micros {
+        self.layout.scan_us
+    }
+
     /// Builds a drive powered up at time 0 in the configured state (manual 4.1, 3.2).
     pub fn new(spec: &Spec, config: DriveConfig) -> Result<Drive, ModelError> {
         let layout = Arc::new(Layout::new(spec, &config.readings)?);
