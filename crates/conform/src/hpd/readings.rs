@@ -245,6 +245,33 @@ impl Journal {
         }
     }
 
+    /// The scan shifts (µs, below one `period`) that put the reference's next scan just
+    /// after each time the case gave it something: one of each order of scans and messages
+    /// the case can see (3.8.1: when a scan falls between two messages is not fixed).
+    pub(crate) fn phases(&self, period: Micros) -> Vec<Micros> {
+        let (Some(next), true) = (self.start.as_ref().and_then(Drive::next_scan), period > 0)
+        else {
+            return Vec::new();
+        };
+        let mut out: Vec<Micros> = Vec::new();
+        for e in &self.entries {
+            let times = match e {
+                Entry::Exchange { at, until, .. } => [Some(*at), Some(*until)],
+                Entry::Listen { until } => [Some(*until), None],
+                Entry::Send { at, .. } | Entry::Inputs { at, .. } | Entry::PowerCycle { at } => {
+                    [Some(*at), None]
+                }
+            };
+            for t in times.into_iter().flatten() {
+                let shift = (t + 1 + period - next % period) % period;
+                if shift != 0 && !out.contains(&shift) {
+                    out.push(shift);
+                }
+            }
+        }
+        out
+    }
+
     /// The judged answers so far.
     pub(crate) fn answers(&self) -> &[Judged] {
         &self.judged

@@ -42,10 +42,6 @@ pub struct HpdSession<'a, 's> {
     journal: Journal,
 }
 
-/// The steps in which the PLC scan phase is tried across one scan (µs): the FIN period of
-/// 3.8.1 (512 µs), finer than any two requests of a case can be apart.
-const PHASE_STEP_US: Micros = 512;
-
 /// The requirement that fixes the scan period but not its phase (3.8.1).
 const SCAN_REQUIREMENT: &str = "HPD-PLC-004";
 
@@ -163,19 +159,16 @@ impl<'a, 's> HpdSession<'a, 's> {
     }
 
     /// The PLC scan phase (3.8.1) under which every answer of the device in the case so far
-    /// fits, tried every [`PHASE_STEP_US`] across one scan period: the reference moves its
+    /// fits, tried with a scan just after each message of the case: the reference moves its
     /// scans by that much. The answer depends on whether a scan fell between two messages,
     /// which the manual bounds (one scan) but does not fix.
     fn admit_phase(&mut self) -> Option<(Micros, Vec<u8>)> {
-        let period = self.oracle.scan_period();
         let readings = self.shown.clone();
-        let mut shift = PHASE_STEP_US;
-        while shift < period {
+        for shift in self.journal.phases(self.oracle.scan_period()) {
             if let Some((drive, true, last)) = self.replay_on(&readings, shift) {
                 self.oracle = drive;
                 return Some((shift, last));
             }
-            shift += PHASE_STEP_US;
         }
         None
     }

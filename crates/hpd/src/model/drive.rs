@@ -74,6 +74,11 @@ impl Drive {
         self.layout.scan_us
     }
 
+    /// When the next PLC scan runs (3.8.1); None before the first power-up.
+    pub fn next_scan(&self) -> Option<Micros> {
+        self.next_scan
+    }
+
     /// Builds a drive powered up at time 0 in the configured state (manual 4.1, 3.2).
     pub fn new(spec: &Spec, config: DriveConfig) -> Result<Drive, ModelError> {
         let layout = Arc::new(Layout::new(spec, &config.readings)?);
