@@ -245,15 +245,19 @@ impl Journal {
         }
     }
 
-    /// The scan shifts (µs, below one `period`) that put the reference's next scan just
-    /// after each time the case gave it something: one of each order of scans and messages
-    /// the case can see (3.8.1: when a scan falls between two messages is not fixed).
+    /// The scan shifts (µs, below one `period`) that put the reference's next scan at the
+    /// case's start (before its first message) or just after each time the case gave it
+    /// something: one of each order of scans and messages the case can see (3.8.1: when a
+    /// scan falls between two messages is not fixed).
     pub(crate) fn phases(&self, period: Micros) -> Vec<Micros> {
-        let (Some(next), true) = (self.start.as_ref().and_then(Drive::next_scan), period > 0)
-        else {
+        let Some(start) = self.start.as_ref() else {
             return Vec::new();
         };
-        let mut out: Vec<Micros> = Vec::new();
+        let (Some(next), true) = (start.next_scan(), period > 0) else {
+            return Vec::new();
+        };
+        let shift_to = |t: Micros| (t + period - next % period) % period;
+        let mut out: Vec<Micros> = vec![shift_to(start.now())];
         for e in &self.entries {
             let times = match e {
                 Entry::Exchange { at, until, .. } => [Some(*at), Some(*until)],
@@ -263,12 +267,13 @@ impl Journal {
                 }
             };
             for t in times.into_iter().flatten() {
-                let shift = (t + 1 + period - next % period) % period;
-                if shift != 0 && !out.contains(&shift) {
+                let shift = shift_to(t + 1);
+                if !out.contains(&shift) {
                     out.push(shift);
                 }
             }
         }
+        out.retain(|s| *s != 0);
         out
     }
 

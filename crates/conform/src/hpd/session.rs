@@ -88,6 +88,9 @@ impl<'a, 's> HpdSession<'a, 's> {
     /// The reference powered up afresh, following the readings shown so far.
     fn base(&mut self) -> Drive {
         let suite = self.suite;
+        if self.shown.is_empty() {
+            return suite.baseline.clone();
+        }
         self.bases
             .get(suite.spec(), suite.family(), &suite.config, &self.shown)
             .cloned()
@@ -162,12 +165,12 @@ impl<'a, 's> HpdSession<'a, 's> {
     /// fits, tried with a scan just after each message of the case: the reference moves its
     /// scans by that much. The answer depends on whether a scan fell between two messages,
     /// which the manual bounds (one scan) but does not fix.
-    fn admit_phase(&mut self) -> Option<(Micros, Vec<u8>)> {
+    fn admit_phase(&mut self) -> Option<Vec<u8>> {
         let readings = self.shown.clone();
         for shift in self.journal.phases(self.oracle.scan_period()) {
             if let Some((drive, true, last)) = self.replay_on(&readings, shift) {
                 self.oracle = drive;
-                return Some((shift, last));
+                return Some(last);
             }
         }
         None
@@ -200,12 +203,10 @@ impl<'a, 's> HpdSession<'a, 's> {
                 Rescue::Passed(self.suite.readings.finding(&option, &reading), answer)
             }
             Err(others) => match self.admit_phase() {
-                Some((shift, answer)) => Rescue::Passed(
+                Some(answer) => Rescue::Passed(
                     Some(Finding::Open {
                         requirement: SCAN_REQUIREMENT.to_owned(),
-                        text: format!(
-                            "a PLC scan fell elsewhere between the messages than in the reference: its scans taken {shift} µs later fit"
-                        ),
+                        text: "a PLC scan fell elsewhere between the messages than in the reference (the phase of the 6.144 ms scan is not fixed)".to_owned(),
                     }),
                     answer,
                 ),
