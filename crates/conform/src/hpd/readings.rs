@@ -245,10 +245,10 @@ impl Journal {
         }
     }
 
-    /// The scan shifts (µs, below one `period`) that put the reference's next scan at the
-    /// case's start (before its first message) or just after each time the case gave it
-    /// something: one of each order of scans and messages the case can see (3.8.1: when a
-    /// scan falls between two messages is not fixed).
+    /// The times for the reference's next scan (within one `period` of the case's start)
+    /// that put a scan at the case's start, before its first message, or just after each
+    /// time the case gave it something: one of each order of scans and messages the case can
+    /// see (3.8.1: when a scan falls between two messages is not fixed).
     pub(crate) fn phases(&self, period: Micros) -> Vec<Micros> {
         let Some(start) = self.start.as_ref() else {
             return Vec::new();
@@ -256,8 +256,9 @@ impl Journal {
         let (Some(next), true) = (start.next_scan(), period > 0) else {
             return Vec::new();
         };
-        let shift_to = |t: Micros| (t + period - next % period) % period;
-        let mut out: Vec<Micros> = vec![shift_to(start.now())];
+        let now = start.now();
+        let first_at = |t: Micros| now + t.saturating_sub(now) % period;
+        let mut out: Vec<Micros> = vec![now];
         for e in &self.entries {
             let times = match e {
                 Entry::Exchange { at, until, .. } => [Some(*at), Some(*until)],
@@ -267,13 +268,13 @@ impl Journal {
                 }
             };
             for t in times.into_iter().flatten() {
-                let shift = shift_to(t + 1);
-                if !out.contains(&shift) {
-                    out.push(shift);
+                let at = first_at(t + 1);
+                if !out.contains(&at) {
+                    out.push(at);
                 }
             }
         }
-        out.retain(|s| *s != 0);
+        out.retain(|t| *t != next);
         out
     }
 
@@ -283,15 +284,17 @@ impl Journal {
     }
 
     /// The case so far on a drive following `readings_of`'s readings from the case's start
-    /// state, its PLC scans moved `shift` µs later: that drive now and its answer to each
-    /// judged step. None without a start.
+    /// state, its next PLC scan moved to `scan_at` when given: that drive now and its answer
+    /// to each judged step. None without a start.
     pub(crate) fn replay(
         &self,
         readings_of: &Drive,
-        shift: Micros,
+        scan_at: Option<Micros>,
     ) -> Option<(Drive, Vec<Vec<u8>>)> {
         let mut d = self.start.as_ref()?.under_readings_of(readings_of);
-        d.shift_scan(shift);
+        if let Some(at) = scan_at {
+            d.move_next_scan(at);
+        }
         let mut answers: Vec<Vec<u8>> = Vec::with_capacity(self.judged.len());
         let mut out: Vec<Vec<u8>> = Vec::with_capacity(self.entries.len());
         for e in &self.entries {

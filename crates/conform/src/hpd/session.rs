@@ -136,21 +136,21 @@ impl<'a, 's> HpdSession<'a, 's> {
     fn replay_with(&mut self, option: &str, reading: &str) -> Option<(Drive, bool, Vec<u8>)> {
         let mut readings = self.shown.clone();
         readings.insert(option.to_owned(), reading.to_owned());
-        self.replay_on(&readings, 0)
+        self.replay_on(&readings, None)
     }
 
-    /// The case so far replayed under `readings` with the PLC scans moved `shift` µs later:
-    /// the drive, whether every judged answer of the device fits, the last answer.
+    /// The case so far replayed under `readings`, the next PLC scan moved to `scan_at` when
+    /// given: the drive, whether every judged answer of the device fits, the last answer.
     fn replay_on(
         &mut self,
         readings: &BTreeMap<String, String>,
-        shift: Micros,
+        scan_at: Option<Micros>,
     ) -> Option<(Drive, bool, Vec<u8>)> {
         let suite = self.suite;
         let base = self
             .bases
             .get(suite.spec(), suite.family(), &suite.config, readings)?;
-        let (drive, answers) = self.journal.replay(base, shift)?;
+        let (drive, answers) = self.journal.replay(base, scan_at)?;
         let fit = self
             .journal
             .answers()
@@ -167,8 +167,8 @@ impl<'a, 's> HpdSession<'a, 's> {
     /// which the manual bounds (one scan) but does not fix.
     fn admit_phase(&mut self) -> Option<Vec<u8>> {
         let readings = self.shown.clone();
-        for shift in self.journal.phases(self.oracle.scan_period()) {
-            if let Some((drive, true, last)) = self.replay_on(&readings, shift) {
+        for at in self.journal.phases(self.oracle.scan_period()) {
+            if let Some((drive, true, last)) = self.replay_on(&readings, Some(at)) {
                 self.oracle = drive;
                 return Some(last);
             }

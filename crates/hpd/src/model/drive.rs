@@ -61,12 +61,19 @@ impl Drive {
         d
     }
 
-    /// The PLC scan grid (and the FIN slots) moved `by` µs later: the same drive with its
-    /// scans at another phase against the line (3.8.1 fixes the 6.144 ms period, not when a
-    /// scan falls between two messages).
-    pub fn shift_scan(&mut self, by: Micros) {
-        self.epoch = self.epoch.saturating_add(by);
-        self.next_scan = self.next_scan.map(|t| t.saturating_add(by));
+    /// The next PLC scan moved to `at` (not before the current time nor a period after it),
+    /// the scan grid and the FIN slots with it: the same drive with its scans at another
+    /// phase against the line (3.8.1 fixes the 6.144 ms period, not when a scan falls
+    /// between two messages).
+    pub fn move_next_scan(&mut self, at: Micros) {
+        let Some(next) = self.next_scan else { return };
+        let at = at.clamp(self.clock, self.clock.saturating_add(self.layout.scan_us));
+        self.epoch = if at >= next {
+            self.epoch.saturating_add(at - next)
+        } else {
+            self.epoch.saturating_sub(next - at)
+        };
+        self.next_scan = Some(at);
     }
 
     /// The PLC scan period (3.8.1, µs).
