@@ -45,6 +45,10 @@ pub struct ConformArgs {
     /// Serial address of the device (HPD Pr27).
     #[arg(long, default_value_t = 0)]
     address: u8,
+    /// Make one erratum strict: only READING of the erratum with OPTION is accepted
+    /// (repeatable; every reading of the other errata is accepted and reported).
+    #[arg(long = "reading", value_name = "OPTION=READING")]
+    reading: Vec<String>,
     /// Extra time allowed for each answer on real transports, in ms.
     #[arg(long, value_name = "MS")]
     slack_ms: Option<u64>,
@@ -85,6 +89,8 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
         }
     };
     let dut: Dut = args.dut.parse()?;
+    let spec = ctx.spec()?;
+    let readings = strict_readings(&spec, &families, &args.reading)?;
     let opts = Options {
         families,
         dut,
@@ -94,6 +100,7 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
             model: args.model,
             slack_us: args.slack_ms.map(|ms| ms.saturating_mul(1000)),
             bit_rate: None,
+            readings,
         },
         case: args.case,
         skip: args.skip,
@@ -116,7 +123,6 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
         },
         command: "drivespec conform".to_owned(),
     };
-    let spec = ctx.spec()?;
     let mut err = std::io::stderr();
     let summary = drivespec_conform::run(&spec, &opts, &mut err)?;
     if opts.list {
@@ -182,4 +188,49 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
     } else {
         Outcome::Fail
     })
+}
+
+/// The `--reading OPTION=READING` pairs, each checked against the errata of the selected
+/// families (all when `families` is empty).
+fn strict_readings(
+    spec: &drivespec_spec::Spec,
+    families: &[FamilyId],
+    given: &[String],
+) -> Result<Vec<(String, String)>> {
+    let selected: Vec<&drivespec_spec::Family> = spec
+        .families()
+        .into_iter()
+        .filter(|f| families.is_empty() || families.contains(&f.info.id))
+        .collect();
+    let mut out = Vec::new();
+    for text in given {
+        let Some((option, reading)) = text.split_once('=') else {
+            bail!("--reading {text:?}: expected OPTION=READING");
+        };
+        let (option, reading) = (option.trim(), reading.trim());
+        let owner = selected
+            .iter()
+            .find(|f| f.errata.iter().any(|e| e.option.as_deref() == Some(option)));
+        let family = match owner {
+            Some(f) => *f,
+            None => match selected.first() {
+                Some(f) if selected.len() == 1 => *f,
+                _ => {
+                    let known: Vec<&str> = selected
+                        .iter()
+                        .flat_map(|f| f.errata.iter().filter_map(|e| e.option.as_deref()))
+                        .collect();
+                    bail!(
+                        "--reading: no erratum option {option:?}; options: {}",
+                        known.join(", ")
+                    );
+                }
+            },
+        };
+        if let Err(e) = drivespec_spec::Readings::default().choose(family, option, reading) {
+            bail!("--reading: {e}");
+        }
+        out.push((option.to_owned(), reading.to_owned()));
+    }
+    Ok(out)
 }

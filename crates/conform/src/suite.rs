@@ -25,6 +25,9 @@ pub struct Settings {
     pub slack_us: Option<Micros>,
     /// Bit rate of the line (serial `?baud=`); None: the delivery value.
     pub bit_rate: Option<u32>,
+    /// Erratum readings made strict (`--reading OPTION=READING`): the only admissible
+    /// reading of that erratum; every reading of the others is accepted.
+    pub readings: Vec<(String, String)>,
 }
 
 /// Why a suite or a session cannot be set up.

@@ -12,9 +12,10 @@
 mod support;
 
 use drivespec_conform::fuzz::{self, FindingClass, Options};
+use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
 use drivespec_sim::SimLink;
-use support::mutants::{mutants, spec, Kind, Mutant};
+use support::mutants::{mutants, spec, strict_readings, Kind, Mutant};
 
 /// Sequences each mutant gets.
 const BOUND: u64 = 80;
@@ -48,6 +49,10 @@ fn every_mutant_is_found_with_a_short_replay() {
             .map(|m| {
                 let opts = Options {
                     iterations: Some(bound(m.kind)),
+                    settings: Settings {
+                        readings: strict_readings(m.kind),
+                        ..opts.settings.clone()
+                    },
                     ..opts.clone()
                 };
                 s.spawn(move || {
@@ -96,6 +101,13 @@ fn every_mutant_is_found_with_a_short_replay() {
         // Every finding replays: the same bytes and the same verdict again.
         for f in &s.findings {
             let link = SimLink::new("mutant", Box::new(Mutant::new(*kind)));
+            let opts = Options {
+                settings: Settings {
+                    readings: strict_readings(*kind),
+                    ..opts.settings.clone()
+                },
+                ..opts.clone()
+            };
             let again = fuzz::replay_on(spec(), &opts, &f.replay, Box::new(link)).unwrap();
             let info = f.replay.finding.as_ref().unwrap();
             if info.reproduced && !(again.same_as_recorded && again.same_finding) {

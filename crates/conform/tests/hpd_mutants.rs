@@ -1,7 +1,8 @@
 //! Mutation tests: the reference drive with one planted deviation (`support::mutants`) as the
 //! device under test. Each mutant must fail at least the cases named for it, and every case it
 //! fails must cite one of the requirements the deviation breaks (no collateral failures). The
-//! score is printed.
+//! score is printed. A mutant following another reading of an erratum is judged with the
+//! adopted reading made strict (`--reading OPTION=ADOPTED`): by default that reading is legal.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -16,16 +17,28 @@ use drivespec_conform::hpd::HpdSuite;
 use drivespec_conform::select::Pattern;
 use drivespec_conform::suite::{Session, Settings, Suite};
 use drivespec_sim::SimLink;
-use support::mutants::{mutants, spec, Mutant};
+use support::mutants::{mutants, spec, strict_readings, Kind, Mutant};
 
 #[test]
 fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
-    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let plain = HpdSuite::new(spec(), &Settings::default()).unwrap();
     let mut caught = 0;
     let mut report = Vec::new();
     let mut problems = Vec::new();
     let all = mutants();
     for m in &all {
+        let strict_suite;
+        let suite = match m.kind {
+            Kind::Reading(..) => {
+                let settings = Settings {
+                    readings: strict_readings(m.kind),
+                    ..Settings::default()
+                };
+                strict_suite = HpdSuite::new(spec(), &settings).unwrap();
+                &strict_suite
+            }
+            _ => &plain,
+        };
         let link = SimLink::new(format!("mutant: {}", m.name), Box::new(Mutant::new(m.kind)));
         let mut session = suite.session(Box::new(link));
         let mut failed = Vec::new();

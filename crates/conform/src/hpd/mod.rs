@@ -21,6 +21,7 @@ pub(crate) mod frame;
 pub(crate) mod fuzz;
 pub(crate) mod names;
 mod params;
+mod readings;
 mod session;
 pub(crate) mod step;
 
@@ -45,6 +46,10 @@ pub struct HpdSuite<'s> {
     protocol: &'s Protocol,
     settings: Settings,
     baseline: Drive,
+    /// How the reference drives are built (start state; readings are per session).
+    config: DriveConfig,
+    /// The errata a device may read either way, and the readings made strict.
+    readings: readings::ReadingRules<'s>,
     infos: Vec<CaseInfo>,
     cases: Vec<HpdCase>,
     rules: FrameRules,
@@ -100,7 +105,8 @@ impl<'s> HpdSuite<'s> {
             Some(c) => DriveConfig::commissioned_at(c, settings.address),
             None => DriveConfig::commissioned(settings.address),
         };
-        let baseline = Drive::new(spec, config).map_err(GenError::from)?;
+        let readings = readings::ReadingRules::new(spec, family, &settings.readings)?;
+        let baseline = Drive::new(spec, config.clone()).map_err(GenError::from)?;
         let mut g = cases::Gen::new(
             spec,
             baseline.clone(),
@@ -122,6 +128,8 @@ impl<'s> HpdSuite<'s> {
             protocol,
             settings: settings.clone(),
             baseline,
+            config,
+            readings,
             infos,
             cases,
             rules,

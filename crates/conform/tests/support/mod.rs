@@ -10,6 +10,7 @@
     clippy::panic
 )]
 
+pub mod hpd_variants;
 pub mod legal;
 pub mod mutants;
 pub mod psd4xx_mutants;

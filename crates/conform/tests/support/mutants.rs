@@ -418,6 +418,21 @@ impl SimDevice for Mutant {
     }
 }
 
+/// The readings a mutant is judged under: for another reading of an erratum, the adopted
+/// one made strict (`--reading OPTION=ADOPTED`), since by default every reading is legal.
+pub fn strict_readings(kind: Kind) -> Vec<(String, String)> {
+    let Kind::Reading(option, _) = kind else {
+        return Vec::new();
+    };
+    let e = spec()
+        .family(FamilyId::Hpd)
+        .errata
+        .iter()
+        .find(|e| e.option.as_deref() == Some(option))
+        .unwrap();
+    vec![(option.to_owned(), e.adopted.clone())]
+}
+
 /// A mutant with what it breaks.
 pub struct Case {
     /// One line.

@@ -2,7 +2,8 @@
 //! takes, and direct access for tests and simulators.
 //!
 //! Decisions where the manual is silent, each marked DECISION below: a refused write changes
-//! nothing and is still acknowledged (see `serial.rs`); a write must cover whole parameters
+//! nothing and is acknowledged, or not answered under the `silent` reading of HPD-ERRATUM-069
+//! (see `serial.rs`); a write must cover whole parameters
 //! (one, or several consecutive ones such as a double word), a bit change may address any
 //! byte of one parameter.
 

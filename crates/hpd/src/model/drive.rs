@@ -51,6 +51,41 @@ pub struct Drive {
 }
 
 impl Drive {
+    /// This drive's state (values, program, line, clock) under the erratum readings `other`
+    /// was built with (spec `[[erratum]]` options): what the same history would be on a drive
+    /// following those readings as long as they did not tell apart so far.
+    pub fn under_readings_of(&self, other: &Drive) -> Drive {
+        let mut d = self.clone();
+        d.layout = Arc::clone(&other.layout);
+        d.command_seen.resize(d.layout.commands.len(), false);
+        d
+    }
+
+    /// The next PLC scan moved to `at` (not before the current time nor a period after it),
+    /// the scan grid and the FIN slots with it: the same drive with its scans at another
+    /// phase against the line (3.8.1 fixes the 6.144 ms period, not when a scan falls
+    /// between two messages).
+    pub fn move_next_scan(&mut self, at: Micros) {
+        let Some(next) = self.next_scan else { return };
+        let at = at.clamp(self.clock, self.clock.saturating_add(self.layout.scan_us));
+        self.epoch = if at >= next {
+            self.epoch.saturating_add(at - next)
+        } else {
+            self.epoch.saturating_sub(next - at)
+        };
+        self.next_scan = Some(at);
+    }
+
+    /// The PLC scan period (3.8.1, µs).
+    pub fn scan_period(&self) -> Micros {
+        self.layout.scan_us
+    }
+
+    /// When the next PLC scan runs (3.8.1); None before the first power-up.
+    pub fn next_scan(&self) -> Option<Micros> {
+        self.next_scan
+    }
+
     /// Builds a drive powered up at time 0 in the configured state (manual 4.1, 3.2).
     pub fn new(spec: &Spec, config: DriveConfig) -> Result<Drive, ModelError> {
         let layout = Arc::new(Layout::new(spec, &config.readings)?);

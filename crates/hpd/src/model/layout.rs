@@ -128,6 +128,8 @@ pub(super) struct Options {
     pub(super) security_serial: bool,
     /// Pr31 accepts any byte (HPD-ERRATUM-014).
     pub(super) mode_any_byte: bool,
+    /// A refused write is not answered (HPD-ERRATUM-069).
+    pub(super) refusal_silent: bool,
 }
 
 /// The serial set-up of manual 4.1 (`protocol.serial_setup`).
@@ -365,6 +367,8 @@ impl Layout {
                 != Some(names::READING_KEYPAD_ONLY),
             mode_any_byte: readings_of(names::OPTION_MODE_RANGE).as_deref()
                 == Some(names::READING_ANY_BYTE),
+            refusal_silent: readings_of(names::OPTION_REFUSED_WRITE).as_deref()
+                == Some(names::READING_SILENT),
         };
         let idc_cmd = rules.code(crate::rules::MessageKind::Broadcast);
         if protocol.idc.cmd != idc_cmd {

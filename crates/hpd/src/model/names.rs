@@ -24,3 +24,7 @@ pub(super) const READING_KEYPAD_ONLY: &str = "keypad-only";
 pub(super) const OPTION_MODE_RANGE: &str = "pr31-range";
 /// Reading of `OPTION_MODE_RANGE` where any byte is accepted.
 pub(super) const READING_ANY_BYTE: &str = "byte";
+/// Erratum option: is a refused write acknowledged (HPD-ERRATUM-069).
+pub(super) const OPTION_REFUSED_WRITE: &str = "refused-write";
+/// Reading of `OPTION_REFUSED_WRITE` where a refused write is not answered.
+pub(super) const READING_SILENT: &str = "silent";

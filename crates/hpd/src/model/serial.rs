@@ -93,8 +93,11 @@ impl Drive {
                 }
             }
             // HPD-FRAME-011: writes, bit changes and PLC writes get the short acknowledge.
+            // HPD-ERRATUM-069: a refused write is acknowledged, or not answered.
             Message::WriteParam { addr, par, data } => {
-                self.write_bytes(par, data.as_slice());
+                if !self.write_bytes(par, data.as_slice()) && layout.options.refusal_silent {
+                    return;
+                }
                 Message::Ack { addr }
             }
             // HPD-FRAME-017, HPD-FRAME-018: the bits where the mask is 0 take the value's bits,
@@ -105,7 +108,9 @@ impl Drive {
                 mask,
                 value,
             } => {
-                self.bit_change(par, mask, value);
+                if !self.bit_change(par, mask, value) && layout.options.refusal_silent {
+                    return;
+                }
                 Message::Ack { addr }
             }
             Message::WritePlc { addr, par, data } => {
