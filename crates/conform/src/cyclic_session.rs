@@ -31,6 +31,11 @@ pub(crate) struct Tolerance {
     pub motion: bool,
 }
 
+/// How much later than the reference a device may make a change that a case ends before
+/// (µs): above any start latency or braking tail a drive has (tens of ms), far below a run
+/// that goes on where the reference stopped.
+const REACTION_US: u64 = 100_000;
+
 /// A live quantity an acyclic read reports, as the input image carries it too.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Live {
@@ -52,6 +57,9 @@ struct LiveRead {
     quantity: Live,
     /// The value read.
     value: i64,
+    /// Whether it equals the reference's reply: the verdict when no device image follows the
+    /// read (the case ends with it).
+    as_reference: bool,
 }
 
 /// Whether both replies carry data of the same length: how a read of a device's own value
@@ -311,6 +319,9 @@ pub(crate) struct CyclicSession<'a, F> {
     /// The device under test; its first transport failure of a case run is a crash or hang
     /// to the fuzzer.
     device: Device<'a>,
+    /// Whether a run still going at a case's end is judged only up to where the device got
+    /// (suite cases); a fuzz sequence cut at its failing step is judged whole.
+    late_end: bool,
 }
 
 /// Whether one side has arrived where an [`Op::Until`] waits: it has shown "Drive is running"
@@ -527,7 +538,17 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     /// A session of `family` on `peer`.
     pub(crate) fn new(family: F, peer: Box<dyn Peer + 'a>) -> CyclicSession<'a, F> {
         let device = Device::new(peer, F::ID, family.model());
-        CyclicSession { family, device }
+        CyclicSession {
+            family,
+            device,
+            late_end: true,
+        }
+    }
+
+    /// The session judging every run whole, also one that goes on at a case's end.
+    pub(crate) fn judging_whole_runs(mut self) -> Self {
+        self.late_end = false;
+        self
     }
 
     /// Exchanges `HELLO`; an error names what the device side said.
@@ -619,13 +640,15 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             .filter(|g| run.tol.motion && same_length(&expected, g).is_some())
             .and_then(|g| self.family.live(&req, g));
         let (ok, remark) = match (&got, live) {
-            (Some(_), Some((quantity, value))) => {
+            (Some(g), Some((quantity, value))) => {
+                let as_reference = self.family.same_reply(&req, &expected, g, run.tol).0;
                 run.live.push(LiveRead {
                     record: run.evidence.len(),
                     step,
                     cycle: run.cycles.len(),
                     quantity,
                     value,
+                    as_reference,
                 });
                 (true, Some(LIVE_NOTE.to_owned()))
             }
@@ -808,6 +831,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     /// does not is marked and is the failure unless one came first.
     fn judge_live(&self, run: &mut Run<'_, 's, F::Input, F::Output>, tol: Tolerance) {
         for l in std::mem::take(&mut run.live) {
+            let after = run.cycles.get(l.cycle).is_some_and(|c| c.dut.is_ok());
+            if !after && l.as_reference {
+                continue;
+            }
             let around: Vec<i64> = [l.cycle.checked_sub(1), Some(l.cycle)]
                 .into_iter()
                 .flatten()
@@ -980,7 +1007,16 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 [a, b] if a < b => (*a, *b),
                 _ => continue,
             };
-            let open = moving_at_end && to == end;
+            let open = self.late_end && moving_at_end && to == end;
+            // A change the device has not made yet is excused only when the reference made
+            // it shortly before the end: a later reaction, not a change never made.
+            let end_t = run.cycles.last().map_or(0, |c| c.t);
+            let late = |unmade: bool, theirs: Option<usize>| {
+                open && unmade
+                    && theirs
+                        .and_then(|t| run.cycles.get(t))
+                        .is_some_and(|c| end_t.saturating_sub(c.t) <= REACTION_US)
+            };
             let segment = run.cycles.get(from..to).unwrap_or(&[]);
             let before = from.checked_sub(1).and_then(|i| run.cycles.get(i));
             let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
@@ -999,7 +1035,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     |_| false,
                     (mask == running).then_some(true),
                 )
-                .filter(|x| !(open && x.device.is_none()))
+                .filter(|x| !late(x.device.is_none(), x.theirs))
                 {
                     bad.push(Finding::at(
                         x.at,
@@ -1030,7 +1066,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 |v| *v == 0,
                 None,
             )
-            .filter(|x| !(movement_open || (open && x.device.is_none())))
+            .filter(|x| !(movement_open || late(x.device.is_none(), x.theirs)))
             {
                 bad.push(Finding::at(
                     x.at,

