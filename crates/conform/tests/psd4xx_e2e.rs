@@ -80,7 +80,7 @@ fn tcp_against_the_reference_server_passes() {
     let bad: Vec<String> = r
         .cases
         .iter()
-        .filter(|c| c.status != Status::Pass)
+        .filter(|c| !matches!(c.status, Status::Pass | Status::Acceptable))
         .map(|c| format!("{} {:?}", c.id, c.failure.as_ref().map(|f| &f.message)))
         .collect();
     assert!(bad.is_empty(), "{bad:#?}");

@@ -63,7 +63,7 @@ fn tcp_against_the_reference_server_passes_and_plots() {
         .report
         .cases
         .iter()
-        .filter(|c| c.status != Status::Pass)
+        .filter(|c| !matches!(c.status, Status::Pass | Status::Acceptable))
         .map(|c| format!("{}: {:?} {:?}", c.id, c.status, c.failure))
         .collect();
     assert!(bad.is_empty(), "{}", bad.join("\n"));
@@ -105,7 +105,12 @@ fn a_model_without_a_documented_code_runs_over_tcp() {
     let summary = run(&spec, &opts, &mut std::io::sink()).unwrap();
     assert!(summary.report.cases.len() >= 5);
     for c in &summary.report.cases {
-        assert_eq!(c.status, Status::Pass, "{}: {:?}", c.id, c.failure);
+        assert!(
+            matches!(c.status, Status::Pass | Status::Acceptable),
+            "{}: {:?}",
+            c.id,
+            c.failure
+        );
     }
 }
 

@@ -108,7 +108,7 @@ fn tcp_against_the_reference_drive_passes() {
     let failed: Vec<String> = r
         .cases
         .iter()
-        .filter(|c| c.status != Status::Pass)
+        .filter(|c| !matches!(c.status, Status::Pass | Status::Acceptable))
         .map(|c| format!("{}: {:?}", c.id, c.failure.as_ref().map(|f| &f.message)))
         .collect();
     assert!(failed.is_empty(), "{failed:#?}");
@@ -220,7 +220,7 @@ fn exec_python_adapter_passes_with_its_expectations() {
         })
         .collect();
     assert!(bad.is_empty(), "{bad:#?}");
-    assert_eq!(r.summary.expected_failures, 4, "{:?}", r.summary);
+    assert_eq!(r.summary.expected_failures, 3, "{:?}", r.summary);
     assert!(r.summary.passed > 60, "{:?}", r.summary);
     assert!(r.stale_expectations.is_empty());
     assert_eq!(summary.exit_code(), 0);
