@@ -316,22 +316,7 @@ fn run_measured(args: &[&str]) -> (i32, String, u64) {
 #[cfg(unix)]
 #[test]
 fn a_device_flooding_the_line_fails_with_bounded_evidence_and_memory() {
-    let relay = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/flooding_hpd_relay.py");
-    let dut = format!("exec:python3 {} {BIN} sim hpd --stdio", relay.display());
-    let dir = temp_dir("hostile", "flood");
-    let (code, stdout, kb) = run_measured(&[
-        "conform",
-        "hpd",
-        "--quiet",
-        "--dut",
-        &dut,
-        "--case",
-        "hpd/frame/*",
-        "--report-dir",
-        dir.to_str().unwrap(),
-    ]);
-    let json = std::fs::read_to_string(dir.join("conform.json")).unwrap_or_default();
-    let _ = std::fs::remove_dir_all(&dir);
+    let (code, stdout, kb, json) = conform_through("flooding_hpd_relay.py", "hpd", "hpd/frame/*");
     assert_eq!(code, 1, "{stdout}");
     assert!(kb < 200_000, "peak memory {kb} KB");
     assert!(
@@ -348,25 +333,38 @@ fn a_device_flooding_the_line_fails_with_bounded_evidence_and_memory() {
 #[cfg(unix)]
 #[test]
 fn a_reply_line_without_end_is_cut_at_the_line_limit() {
-    let relay = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/endless_line_relay.py");
-    let dut = format!("exec:python3 {} {BIN} sim psd4xx --stdio", relay.display());
-    let dir = temp_dir("hostile", "endless");
+    let (code, stdout, kb, json) =
+        conform_through("endless_line_relay.py", "psd4xx", "psd4xx/pkw/read/1");
+    assert_eq!(code, 1, "{stdout}");
+    assert!(kb < 200_000, "peak memory {kb} KB");
+    assert!(json.contains("no line end within 4096 bytes"), "{json}");
+}
+
+/// `conform FAMILY --case CASE` against the simulator behind the hostile relay `script`
+/// (in `tests/`), measured: exit code, stdout, peak memory (KB) and the JSON report.
+fn conform_through(script: &str, family: &str, case: &str) -> (i32, String, u64, String) {
+    let relay = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests")
+        .join(script);
+    let dut = format!(
+        "exec:python3 {} {BIN} sim {family} --stdio",
+        relay.display()
+    );
+    let dir = temp_dir("hostile", script);
     let (code, stdout, kb) = run_measured(&[
         "conform",
-        "psd4xx",
+        family,
         "--quiet",
         "--dut",
         &dut,
         "--case",
-        "psd4xx/pkw/read/1",
+        case,
         "--report-dir",
         dir.to_str().unwrap(),
     ]);
     let json = std::fs::read_to_string(dir.join("conform.json")).unwrap_or_default();
     let _ = std::fs::remove_dir_all(&dir);
-    assert_eq!(code, 1, "{stdout}");
-    assert!(kb < 200_000, "peak memory {kb} KB");
-    assert!(json.contains("no line end within 4096 bytes"), "{json}");
+    (code, stdout, kb, json)
 }
 
 #[test]

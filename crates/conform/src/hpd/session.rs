@@ -62,6 +62,14 @@ enum Rescue {
 /// judged step).
 type Alternative = (String, String, Vec<u8>);
 
+/// What a judged step leaves for its record when another reading or scan phase decides it:
+/// the admissible answer that fits, the finding, or what else was admissible.
+struct Other<'o> {
+    answer: &'o mut Answer,
+    findings: &'o mut Vec<Finding>,
+    also: &'o mut String,
+}
+
 /// A judged step's (match, explanation), nothing to judge, or a transport error with the
 /// reference's answer.
 type StepResult = Result<Option<(bool, String)>, (LinkError, Vec<Chunk>)>;
@@ -402,6 +410,36 @@ impl<'a, 's> HpdSession<'a, 's> {
                 late: Vec::new(),
             }),
             Err(e) => Err((e, expected)),
+        }
+    }
+
+    /// Records the device's answer to a judged step and, when the reference's does not fit
+    /// (`fit`), tries the other readings and scan phases; whether the step passes.
+    fn judged(
+        &mut self,
+        judge: Judge,
+        fit: bool,
+        obs: &Observed,
+        request: Option<&Message>,
+        other: &mut Other<'_>,
+    ) -> bool {
+        let got = concat(&obs.got);
+        self.journal.judged(judge, &got);
+        if fit {
+            return true;
+        }
+        match self.rescue(&concat(&obs.expected), obs.t0, request) {
+            Rescue::Passed(finding, answer) => {
+                other.findings.extend(finding);
+                let at = obs.expected.first().map_or(obs.t0, |c| c.at);
+                let alt = [Chunk { at, bytes: answer }];
+                *other.answer = self.answer(&alt, obs.t0, request);
+                true
+            }
+            Rescue::Failed(text) => {
+                *other.also = text;
+                false
+            }
         }
     }
 
@@ -869,19 +907,12 @@ impl HpdSession<'_, '_> {
                                 _ => fits(&suite.rules, judge, &exp, &got),
                             };
                             if judged {
-                                self.journal.judged(judge, &got);
-                            }
-                            if !ok && judged {
-                                match self.rescue(&exp, obs.t0, request.as_ref()) {
-                                    Rescue::Passed(finding, answer) => {
-                                        ok = true;
-                                        findings.extend(finding);
-                                        let at = obs.expected.first().map_or(obs.t0, |c| c.at);
-                                        let alt = [Chunk { at, bytes: answer }];
-                                        ea = self.answer(&alt, obs.t0, request.as_ref());
-                                    }
-                                    Rescue::Failed(text) => also = text,
-                                }
+                                let mut other = Other {
+                                    answer: &mut ea,
+                                    findings: &mut findings,
+                                    also: &mut also,
+                                };
+                                ok = self.judged(judge, ok, &obs, request.as_ref(), &mut other);
                             }
                             let mut why = format!("expected {}, got {}", show(&ea), show(&ga));
                             if let (true, Some(ed), Some(gd)) =
@@ -972,19 +1003,18 @@ impl HpdSession<'_, '_> {
                             let got = concat(&obs.got);
                             let mut ok = fits(&suite.rules, Judge::Listen, &exp, &got);
                             if judged {
-                                self.journal.judged(Judge::Listen, &got);
-                            }
-                            if !ok && judged {
-                                match self.rescue(&exp, obs.t0, last_request.as_ref()) {
-                                    Rescue::Passed(finding, answer) => {
-                                        ok = true;
-                                        findings.extend(finding);
-                                        let at = obs.expected.first().map_or(obs.t0, |c| c.at);
-                                        let alt = [Chunk { at, bytes: answer }];
-                                        ea = self.answer(&alt, obs.t0, last_request.as_ref());
-                                    }
-                                    Rescue::Failed(text) => also = text,
-                                }
+                                let mut other = Other {
+                                    answer: &mut ea,
+                                    findings: &mut findings,
+                                    also: &mut also,
+                                };
+                                ok = self.judged(
+                                    Judge::Listen,
+                                    ok,
+                                    &obs,
+                                    last_request.as_ref(),
+                                    &mut other,
+                                );
                             }
                             let why = format!(
                                 "expected {} while listening, got {}",
