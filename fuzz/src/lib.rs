@@ -18,6 +18,8 @@ pub mod hpd;
 pub mod pd;
 pub mod psd4xx;
 pub mod psx3xx;
+pub mod script;
+pub mod select;
 
 /// A fuzz target: its name and the function it runs on each input.
 pub type Target = (&'static str, fn(&[u8]));
@@ -46,4 +48,8 @@ pub const TARGETS: &[Target] = &[
     ("check_profinet", check::profinet),
     ("check_iolink", check::iolink),
     ("check_psd4xx", check::psd4xx),
+    ("script_psd4xx", script::psd4xx),
+    ("script_psx3xx", script::psx3xx),
+    ("select_pattern", select::pattern),
+    ("select_expectations", select::expectations),
 ];

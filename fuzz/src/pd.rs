@@ -6,17 +6,17 @@ use drivespec_psd4xx::{CommandCode, Direction, Pkw, RecordRead, RecordWrite, Res
 use drivespec_spec::Spec;
 use std::sync::OnceLock;
 
-fn spec() -> &'static Spec {
+pub(crate) fn spec() -> &'static Spec {
     static SPEC: OnceLock<Spec> = OnceLock::new();
     SPEC.get_or_init(|| Spec::builtin().expect("the built-in spec loads"))
 }
 
-fn psd() -> &'static drivespec_psd4xx::Rules {
+pub(crate) fn psd() -> &'static drivespec_psd4xx::Rules {
     static RULES: OnceLock<drivespec_psd4xx::Rules> = OnceLock::new();
     RULES.get_or_init(|| drivespec_psd4xx::Rules::from_spec(spec()).expect("PSD4xx rules"))
 }
 
-fn psx() -> &'static drivespec_psx3xx::Rules<'static> {
+pub(crate) fn psx() -> &'static drivespec_psx3xx::Rules<'static> {
     static RULES: OnceLock<drivespec_psx3xx::Rules<'static>> = OnceLock::new();
     RULES.get_or_init(|| drivespec_psx3xx::Rules::from_spec(spec()).expect("PSx3xx rules"))
 }

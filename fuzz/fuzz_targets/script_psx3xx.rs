@@ -1,0 +1,4 @@
+//! cargo-fuzz target `script_psx3xx`: see `drivespec_fuzz::script::psx3xx`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::script::psx3xx(data));
