@@ -1,4 +1,4 @@
-//! cargo-fuzz target `capture_frame`: see `drivespec_fuzz::capture::frame`.
+//! cargo-fuzz target `capture_frame`: see `drivespec_fuzz_targets::capture::frame`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::capture::frame(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::capture::frame(data));

@@ -1,4 +1,4 @@
-//! cargo-fuzz target `capture_pcap`: see `drivespec_fuzz::capture::pcap`.
+//! cargo-fuzz target `capture_pcap`: see `drivespec_fuzz_targets::capture::pcap`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::capture::pcap(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::capture::pcap(data));

@@ -1,4 +1,4 @@
-//! cargo-fuzz target `capture_serial`: see `drivespec_fuzz::capture::serial`.
+//! cargo-fuzz target `capture_serial`: see `drivespec_fuzz_targets::capture::serial`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::capture::serial(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::capture::serial(data));

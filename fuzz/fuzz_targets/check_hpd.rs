@@ -1,4 +1,4 @@
-//! cargo-fuzz target `check_hpd`: see `drivespec_fuzz::check::hpd`.
+//! cargo-fuzz target `check_hpd`: see `drivespec_fuzz_targets::check::hpd`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::check::hpd(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::check::hpd(data));

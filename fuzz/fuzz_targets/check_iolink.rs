@@ -1,4 +1,4 @@
-//! cargo-fuzz target `check_iolink`: see `drivespec_fuzz::check::iolink`.
+//! cargo-fuzz target `check_iolink`: see `drivespec_fuzz_targets::check::iolink`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::check::iolink(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::check::iolink(data));

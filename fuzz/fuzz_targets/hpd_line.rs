@@ -1,4 +1,4 @@
-//! cargo-fuzz target `hpd_line`: see `drivespec_fuzz::hpd::line`.
+//! cargo-fuzz target `hpd_line`: see `drivespec_fuzz_targets::hpd::line`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::hpd::line(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::hpd::line(data));

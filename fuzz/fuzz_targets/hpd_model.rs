@@ -1,4 +1,4 @@
-//! cargo-fuzz target `hpd_model`: see `drivespec_fuzz::hpd::model`.
+//! cargo-fuzz target `hpd_model`: see `drivespec_fuzz_targets::hpd::model`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::hpd::model(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::hpd::model(data));

@@ -1,4 +1,4 @@
-//! cargo-fuzz target `hpd_plc`: see `drivespec_fuzz::hpd::plc`.
+//! cargo-fuzz target `hpd_plc`: see `drivespec_fuzz_targets::hpd::plc`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::hpd::plc(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::hpd::plc(data));

@@ -1,4 +1,4 @@
-//! cargo-fuzz target `hpd_roundtrip`: see `drivespec_fuzz::hpd::roundtrip`.
+//! cargo-fuzz target `hpd_roundtrip`: see `drivespec_fuzz_targets::hpd::roundtrip`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::hpd::roundtrip(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::hpd::roundtrip(data));

@@ -1,4 +1,4 @@
-//! cargo-fuzz target `psx3xx_image`: see `drivespec_fuzz::pd::psx3xx_image`.
+//! cargo-fuzz target `psx3xx_image`: see `drivespec_fuzz_targets::pd::psx3xx_image`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::pd::psx3xx_image(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::pd::psx3xx_image(data));

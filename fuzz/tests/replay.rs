@@ -7,7 +7,7 @@ use std::path::Path;
 fn every_corpus_file_replays_without_a_finding() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../corpus");
     let mut replayed = 0;
-    for (name, target) in drivespec_fuzz::TARGETS {
+    for (name, target) in drivespec_fuzz_targets::TARGETS {
         let dir = root.join(name);
         let entries: Vec<_> = std::fs::read_dir(&dir)
             .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
@@ -25,5 +25,5 @@ fn every_corpus_file_replays_without_a_finding() {
             replayed += 1;
         }
     }
-    assert!(replayed >= drivespec_fuzz::TARGETS.len());
+    assert!(replayed >= drivespec_fuzz_targets::TARGETS.len());
 }

@@ -1,12 +1,12 @@
-//! `drivespec fuzz`: argument parsing and printing around `drivespec_conform::fuzz`
-//! (crates/conform/README.md, "Fuzzing").
+//! `drivespec fuzz`: argument parsing and printing around `drivespec_fuzz`
+//! (crates/fuzz/README.md).
 
 use crate::{json, Context, Format, Outcome};
 use anyhow::{bail, Context as _, Result};
 use drivespec_conform::dut::Dut;
-use drivespec_conform::fuzz::{self, Options, Replay, ReplayOutcome};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
+use drivespec_fuzz::{self as fuzz, Options, Replay, ReplayOutcome};
 use drivespec_spec::FamilyId;
 use std::path::{Path, PathBuf};
 use std::time::Duration;

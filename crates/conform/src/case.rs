@@ -39,7 +39,7 @@ pub struct RequirementRef {
 
 impl RequirementRef {
     /// The requirement `id` of `family` with its level and text; None when the spec lacks it.
-    pub(crate) fn of(family: &Family, id: &str) -> Option<RequirementRef> {
+    pub fn of(family: &Family, id: &str) -> Option<RequirementRef> {
         family.requirement(id).map(|r| RequirementRef {
             id: r.id.clone(),
             level: r.level,

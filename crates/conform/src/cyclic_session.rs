@@ -19,7 +19,7 @@ use drivespec_spec::{Family, FamilyId, RuleAction};
 
 /// Declared tolerances of a case (physics); everything else is exact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub(crate) struct Tolerance {
+pub struct Tolerance {
     /// A device sample may match a reference sample this many cycles earlier or later.
     pub cycles: u32,
     /// Actual position, in the family's position unit.
@@ -38,7 +38,7 @@ const REACTION_US: u64 = 100_000;
 
 /// A live quantity an acyclic read reports, as the input image carries it too.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Live {
+pub enum Live {
     /// Actual position.
     Position,
     /// Actual speed.
@@ -82,7 +82,7 @@ const SPEED_SLACK_PERCENT: i64 = 5;
 
 /// Tolerance of the motion cases: judged by the properties of the run, positions within 20
 /// units at standstill, speed within the reference's highest plus slack and 2 rpm.
-pub(crate) const MOTION: Tolerance = Tolerance {
+pub const MOTION: Tolerance = Tolerance {
     cycles: 0,
     position: 20,
     speed: 2,
@@ -93,7 +93,7 @@ pub(crate) const MOTION: Tolerance = Tolerance {
 /// with `movement`, the direction of travel there are not judged; the case reports what the
 /// device showed as a finding.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) struct OpenPoint {
+pub struct OpenPoint {
     /// The requirement the point belongs to.
     pub requirement: String,
     /// What the manual leaves open.
@@ -106,7 +106,7 @@ pub(crate) struct OpenPoint {
 
 /// One step: who it is for, one line, what it does.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct StepDef<A> {
+pub struct StepDef<A> {
     /// Setup, check or cleanup.
     pub role: Role,
     /// One line.
@@ -116,7 +116,7 @@ pub(crate) struct StepDef<A> {
 }
 
 /// What a step does, as the session runs it.
-pub(crate) enum Op<O> {
+pub enum Op<O> {
     /// The output becomes this, then up to `max` cycles until the reference and the device
     /// have answered the step ([`CyclicFamily::answered`]).
     Send {
@@ -170,7 +170,7 @@ fn at_time(req: &Request, t: u64) -> Request {
 /// What a cyclic family's session needs from the family: its reference, images, steps and
 /// reply comparison.
 /// `'s` is the lifetime of the reference server.
-pub(crate) trait CyclicFamily<'s> {
+pub trait CyclicFamily<'s> {
     /// The input image.
     type Input: Copy;
     /// The output image.
@@ -314,7 +314,7 @@ pub(crate) fn peer<'p>(
 }
 
 /// A session of family `F` on one device under test.
-pub(crate) struct CyclicSession<'a, F> {
+pub struct CyclicSession<'a, F> {
     family: F,
     /// The device under test; its first transport failure of a case run is a crash or hang
     /// to the fuzzer.
@@ -546,23 +546,23 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     }
 
     /// The session judging every run whole, also one that goes on at a case's end.
-    pub(crate) fn judging_whole_runs(mut self) -> Self {
+    pub fn judging_whole_runs(mut self) -> Self {
         self.late_end = false;
         self
     }
 
     /// Exchanges `HELLO`; an error names what the device side said.
-    pub(crate) fn hello(&mut self) -> Result<String, String> {
+    pub fn hello(&mut self) -> Result<String, String> {
         self.device.hello()
     }
 
     /// The first transport failure of the case run last, if any (taken).
-    pub(crate) fn take_peer_error(&mut self) -> Option<PeerError> {
+    pub fn take_peer_error(&mut self) -> Option<PeerError> {
         self.device.take_error()
     }
 
     /// Whether the device takes the injection `env` ([`Device::takes`]).
-    pub(crate) fn takes(&mut self, env: Env) -> bool {
+    pub fn takes(&mut self, env: Env) -> bool {
         self.device.takes(env)
     }
 
@@ -1283,7 +1283,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
 
     /// Runs one case (a generated one, or a fuzz sequence) against the device and a fresh
     /// reference.
-    pub(crate) fn run_case(&mut self, info: &CaseInfo, case: &F::Case) -> CaseRun {
+    pub fn run_case(&mut self, info: &CaseInfo, case: &F::Case) -> CaseRun {
         self.run_against(info, case, self.family.server())
     }
 

@@ -4,7 +4,8 @@
 //!
 //! - [`suite`]: the [`suite::Suite`]/[`suite::Session`] traits a family implements; HPD in
 //!   [`hpd`], PSD4xx in [`psd4xx`], PSx3xx in [`psx3xx`] (the last two over the
-//!   cyclic-exchange protocol of [`cyclic`]).
+//!   cyclic-exchange protocol of [`cyclic`], run by [`cyclic_session`]). `drivespec-fuzz` runs
+//!   its sequences through these sessions.
 //! - [`link`]: the transports (`serial`, `tcp`, `exec`) behind [`link::Link`] (the crate
 //!   `drivespec-link`); `--dut sim` runs the reference models of `drivespec-sim`.
 //! - [`runner`]: selection, expectations, progress, reports; [`runner::run`] is what the CLI
@@ -17,9 +18,8 @@
 
 pub mod case;
 pub mod cyclic;
-mod cyclic_session;
+pub mod cyclic_session;
 pub mod dut;
-pub mod fuzz;
 pub mod hpd;
 pub mod psd4xx;
 pub mod psx3xx;

@@ -1,6 +1,6 @@
 //! The HPD step language: what a master puts on the line, how long it listens, what it does
 //! to the drive's supply and inputs, and how an answer is compared with the reference
-//! model's (manual chapter 4; fuzz replay files, `crates/conform/README.md` "Replay files").
+//! model's (manual chapter 4; fuzz replay files, `crates/fuzz/README.md` "Replay files").
 //!
 //! A step reads and writes as one record whose key `do` names it
 //! (`{"do": "exchange", "hex": "02 C6 48", "compare": "exact"}`); every step is

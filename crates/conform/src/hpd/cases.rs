@@ -15,22 +15,20 @@ use drivespec_spec::{Family, FamilyId, Level, Parameter, Ranges, Spec};
 use std::collections::BTreeSet;
 
 /// A case being written.
-pub(crate) struct CaseB {
+pub struct CaseB {
     pub(crate) id: String,
     pub(crate) description: String,
     pub(crate) explicit: Vec<String>,
-    pub(crate) steps: Vec<Step>,
+    /// The steps so far.
+    pub steps: Vec<Step>,
     pub(crate) needs_power_cycle: bool,
     pub(crate) touched: Vec<Slot>,
     pub(crate) level: Option<Level>,
 }
 
 impl CaseB {
-    pub(crate) fn new(
-        id: impl Into<String>,
-        description: impl Into<String>,
-        reqs: &[&str],
-    ) -> CaseB {
+    /// An empty case with its id, description and requirement IDs.
+    pub fn new(id: impl Into<String>, description: impl Into<String>, reqs: &[&str]) -> CaseB {
         CaseB {
             id: id.into(),
             description: description.into(),
@@ -108,29 +106,37 @@ impl CaseB {
 }
 
 /// Everything fixed while cases are generated.
-pub(crate) struct Gen<'s> {
-    pub(crate) family: &'s Family,
-    pub(crate) protocol: &'s Protocol,
-    pub(crate) rules: FrameRules,
+pub struct Gen<'s> {
+    /// The HPD family of the spec.
+    pub family: &'s Family,
+    /// Its protocol table (manual chapter 4).
+    pub protocol: &'s Protocol,
+    /// The framing rules (manual 4.1).
+    pub rules: FrameRules,
     pub(crate) map: ParamMap,
-    pub(crate) codec: PlcCodec,
+    /// The PLC instruction codec (manual appendix G).
+    pub codec: PlcCodec,
     pub(crate) baseline: Drive,
     pub(crate) model: Option<&'s drivespec_spec::DeviceModel>,
     /// The device's own address (Pr27).
-    pub(crate) addr: u8,
+    pub addr: u8,
     pub(crate) rng: Rng,
     pub(crate) cases: Vec<(CaseInfo, HpdCase)>,
-    pub(crate) errors: Vec<String>,
+    /// Messages that could not be built, with the reason.
+    pub errors: Vec<String>,
     /// Pb99 and the PLC run bit b99.13.
     pub(crate) run: (Slot, BitAddr),
 }
 
 /// A bit of a parameter by name: the parameter, its slot, the bit number and byte address.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct BitRef<'s> {
-    pub(crate) param: &'s Parameter,
-    pub(crate) slot: Slot,
-    pub(crate) bit: u32,
+pub struct BitRef<'s> {
+    /// The parameter.
+    pub param: &'s Parameter,
+    /// Its slot in the drive's memory.
+    pub slot: Slot,
+    /// The bit number.
+    pub bit: u32,
     pub(crate) at: BitAddr,
 }
 
@@ -159,7 +165,8 @@ pub enum GenError {
 }
 
 impl<'s> Gen<'s> {
-    pub(crate) fn new(
+    /// The generator over `spec` for a device like `baseline` at `addr`, drawing from `seed`.
+    pub fn new(
         spec: &'s Spec,
         baseline: Drive,
         model: Option<&'s drivespec_spec::DeviceModel>,
@@ -195,24 +202,24 @@ impl<'s> Gen<'s> {
     // ------------------------------------------------------------------ lookups
 
     /// A parameter by id (`Pr33`, `Pb99`).
-    pub(crate) fn param(&self, id: &str) -> Option<&'s Parameter> {
+    pub fn param(&self, id: &str) -> Option<&'s Parameter> {
         self.family.parameter(id)
     }
 
     /// Serial slot of a parameter.
-    pub(crate) fn slot(&self, p: &Parameter) -> Option<Slot> {
+    pub fn slot(&self, p: &Parameter) -> Option<Slot> {
         let addr = u8::try_from(p.address?).ok()?;
         let size = u8::try_from(p.size?).ok()?;
         Some(Slot { addr, size })
     }
 
     /// Slot of a parameter by id.
-    pub(crate) fn slot_of(&self, id: &str) -> Option<Slot> {
+    pub fn slot_of(&self, id: &str) -> Option<Slot> {
         self.param(id).and_then(|p| self.slot(p))
     }
 
     /// A bit by name (`b99.13`).
-    pub(crate) fn bit_ref(&self, name: &str) -> Option<BitRef<'s>> {
+    pub fn bit_ref(&self, name: &str) -> Option<BitRef<'s>> {
         let target = Target::parse(self.family, name).ok()?;
         let Target::Bit(param, bit) = target else {
             return None;
@@ -229,12 +236,12 @@ impl<'s> Gen<'s> {
     }
 
     /// The raw start value of a slot (the reference drive as commissioned).
-    pub(crate) fn base(&self, slot: Slot) -> u32 {
+    pub fn base(&self, slot: Slot) -> u32 {
         self.baseline.memory().get(slot.addr, slot.size)
     }
 
     /// The range of a parameter in operating mode `mode` (manual 3.3, 3.6).
-    pub(crate) fn range_in(&self, p: &Parameter, mode: Option<u32>) -> Option<Ranges> {
+    pub fn range_in(&self, p: &Parameter, mode: Option<u32>) -> Option<Ranges> {
         if let Some(m) = mode {
             if let Some(r) = p
                 .modes
@@ -249,7 +256,7 @@ impl<'s> Gen<'s> {
     }
 
     /// The operating modes in which `p` has a range of its own (manual 3.6).
-    pub(crate) fn ranged_modes(p: &Parameter) -> Vec<u32> {
+    pub fn ranged_modes(p: &Parameter) -> Vec<u32> {
         p.modes
             .iter()
             .filter(|m| m.range.is_some())
@@ -258,12 +265,12 @@ impl<'s> Gen<'s> {
     }
 
     /// The requirement IDs in the spec (so cases never cite a missing one).
-    pub(crate) fn known(&self, id: &str) -> bool {
+    pub fn known(&self, id: &str) -> bool {
         self.family.requirement(id).is_some()
     }
 
     /// Must/should requirements that name `p` and whose text satisfies `pred`.
-    pub(crate) fn linked(&self, p: &Parameter, pred: impl Fn(&str) -> bool) -> Vec<String> {
+    pub fn linked(&self, p: &Parameter, pred: impl Fn(&str) -> bool) -> Vec<String> {
         self.family
             .requirements
             .iter()
@@ -336,7 +343,7 @@ impl<'s> Gen<'s> {
     }
 
     /// A message step with the requirements it exercises.
-    pub(crate) fn msg(
+    pub fn msg(
         &mut self,
         cb: &mut CaseB,
         role: Role,
@@ -366,7 +373,7 @@ impl<'s> Gen<'s> {
     }
 
     /// Raw bytes (malformed frames) with the requirements given.
-    pub(crate) fn raw(
+    pub fn raw(
         &mut self,
         cb: &mut CaseB,
         role: Role,
@@ -501,7 +508,7 @@ impl<'s> Gen<'s> {
     }
 
     /// Set or clear one bit with a bit change (manual 4.1 CMD 6).
-    pub(crate) fn bit(&mut self, cb: &mut CaseB, role: Role, b: &BitRef<'_>, value: bool) {
+    pub fn bit(&mut self, cb: &mut CaseB, role: Role, b: &BitRef<'_>, value: bool) {
         self.bit_at(cb, role, self.addr, b, value);
     }
 
@@ -539,7 +546,7 @@ impl<'s> Gen<'s> {
     }
 
     /// How to compare a read of parameter `p` (in operating mode `mode`).
-    pub(crate) fn compare_for(&self, p: &Parameter, mode: Option<u32>) -> Compare {
+    pub fn compare_for(&self, p: &Parameter, mode: Option<u32>) -> Compare {
         let width = p.size.unwrap_or(2).min(4) * 8;
         let all = if width >= 32 {
             u32::MAX
@@ -627,7 +634,7 @@ impl<'s> Gen<'s> {
 
     /// Setup: stop the PLC (b99.13 = 0, manual 3.2: the default program drives Pr5, Pr92 and
     /// bits of Pb40 and Pb91 while it runs), with a word write of Pb99.
-    pub(crate) fn stop_plc(&mut self, cb: &mut CaseB) {
+    pub fn stop_plc(&mut self, cb: &mut CaseB) {
         let (slot, at) = self.run;
         let value = self.base(slot) & !bit_value(slot, at);
         self.write(
@@ -824,7 +831,7 @@ impl<'s> Gen<'s> {
 }
 
 /// The raw value of `slot` as the signed or unsigned number of its parameter.
-pub(crate) fn sign_for(slot: Slot, raw: u32, family: &Family) -> i64 {
+pub fn sign_for(slot: Slot, raw: u32, family: &Family) -> i64 {
     let signed = family
         .parameter_at_address(u32::from(slot.addr))
         .is_some_and(|p| p.data_type.signed());

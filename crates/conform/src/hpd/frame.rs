@@ -9,7 +9,7 @@ use drivespec_hpd::memory::Slot;
 use drivespec_hpd::{Data, Message, MessageKind};
 
 /// The fields after STX with a checksum (`None`: the correct one), stuffed, behind STX.
-pub(crate) fn frame(g: &Gen, fields: &[u8], chk: Option<u8>) -> Vec<u8> {
+pub fn frame(g: &Gen, fields: &[u8], chk: Option<u8>) -> Vec<u8> {
     let sum = fields.iter().fold(0u8, |s, b| s.wrapping_add(*b));
     let mut out = vec![g.rules.stx];
     for b in fields.iter().copied().chain([chk.unwrap_or(sum)]) {

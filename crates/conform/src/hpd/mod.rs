@@ -16,14 +16,13 @@
 //! | `vector` | the spec's `hpd-frame` vectors, at their drive address |
 
 mod behaviour;
-pub(crate) mod cases;
-pub(crate) mod frame;
-pub(crate) mod fuzz;
-pub(crate) mod names;
+pub mod cases;
+pub mod frame;
+pub mod names;
 mod params;
 mod readings;
 mod session;
-pub(crate) mod step;
+pub mod step;
 
 pub use cases::GenError;
 pub use session::HpdSession;
@@ -138,7 +137,8 @@ impl<'s> HpdSuite<'s> {
         })
     }
 
-    pub(crate) fn family(&self) -> &'s Family {
+    /// The HPD family of the spec.
+    pub fn family(&self) -> &'s Family {
         self.spec.family(FamilyId::Hpd)
     }
 
@@ -152,27 +152,27 @@ impl<'s> HpdSuite<'s> {
     }
 
     /// Case `index` with its steps (the fuzzer's seeds).
-    pub(crate) fn case(&self, index: usize) -> Option<(&CaseInfo, &HpdCase)> {
+    pub fn case(&self, index: usize) -> Option<(&CaseInfo, &HpdCase)> {
         Some((self.infos.get(index)?, self.cases.get(index)?))
     }
 
     /// The settings the suite was generated for.
-    pub(crate) fn settings(&self) -> &Settings {
+    pub fn settings(&self) -> &Settings {
         &self.settings
     }
 
     /// The spec the suite was generated from.
-    pub(crate) fn spec(&self) -> &'s Spec {
+    pub fn spec(&self) -> &'s Spec {
         self.spec
     }
 
     /// The device model the suite was generated for, by id.
-    pub(crate) fn model_id(&self) -> Option<&str> {
+    pub fn model_id(&self) -> Option<&str> {
         self.model.as_deref()
     }
 
     /// Opens the transport `dut` names, on the suite's reference drive for `sim`.
-    pub(crate) fn link(&self, dut: &Dut) -> Result<Box<dyn Link>, SetupError> {
+    pub fn link(&self, dut: &Dut) -> Result<Box<dyn Link>, SetupError> {
         self.open_link(dut)
     }
 

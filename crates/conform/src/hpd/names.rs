@@ -3,37 +3,37 @@
 //! masks, ranges and defaults still come from the spec's parameter table.
 
 /// Operating mode (manual 3.3 Pr31, 3.6).
-pub(crate) const OPERATING_MODE: &str = "Pr31";
+pub const OPERATING_MODE: &str = "Pr31";
 /// Extended menu, needed by b42.3 and b94.1 (manual 3.3 b99.6, 3.4).
-pub(crate) const EXTENDED_MENU: &str = "b99.6";
+pub const EXTENDED_MENU: &str = "b99.6";
 /// Security (manual 3.3 b99.7).
-pub(crate) const SECURITY: &str = "b99.7";
+pub const SECURITY: &str = "b99.7";
 /// Reserved reference select, must be 0 for b99.11 (manual 3.3 b40.2, 3.4).
-pub(crate) const RESERVED_REFERENCE: &str = "b40.2";
+pub const RESERVED_REFERENCE: &str = "b40.2";
 /// Alarm reset command (manual 3.4 b99.10).
-pub(crate) const ALARM_RESET: &str = "b99.10";
+pub const ALARM_RESET: &str = "b99.10";
 /// Operating-mode defaults command (manual 3.4 b99.11).
-pub(crate) const MODE_DEFAULTS: &str = "b99.11";
+pub const MODE_DEFAULTS: &str = "b99.11";
 /// Active and last alarm (manual 3.3 Pr23, Pr24).
-pub(crate) const ALARMS: [&str; 2] = ["Pr23", "Pr24"];
+pub const ALARMS: [&str; 2] = ["Pr23", "Pr24"];
 /// A saved word free for the user (manual 3.8.1 Pr80), the usual scratch parameter.
-pub(crate) const SCRATCH: &str = "Pr80";
+pub const SCRATCH: &str = "Pr80";
 /// Its neighbour, the high word of the `SCRATCH` double word (manual 3.8.1 Pr81).
-pub(crate) const SCRATCH_HIGH: &str = "Pr81";
+pub const SCRATCH_HIGH: &str = "Pr81";
 /// A word parameter with a narrow range (manual 3.3 Pr33, raw 100..500).
-pub(crate) const RANGED: &str = "Pr33";
+pub const RANGED: &str = "Pr33";
 /// A read-only, not live parameter (manual 3.3 Pr25, software version).
-pub(crate) const READ_ONLY: &str = "Pr25";
+pub const READ_ONLY: &str = "Pr25";
 /// A saved parameter with a delivery value (manual 3.3 Pr2).
-pub(crate) const WITH_DEFAULT: &str = "Pr2";
+pub const WITH_DEFAULT: &str = "Pr2";
 /// A user flag bit (manual 3.8.1 b90.8).
-pub(crate) const USER_FLAG: &str = "b90.8";
+pub const USER_FLAG: &str = "b90.8";
 
 /// Bit-rule trigger of command bits (bits.toml).
-pub(crate) const TRIGGER_COMMAND: &str = "command-executed";
+pub const TRIGGER_COMMAND: &str = "command-executed";
 /// Bit-rule trigger of the end of the wiring test (bits.toml b70.3): manual 3.6.3 gives the
 /// test no duration, so a read right after the start may show b70.3 either way.
-pub(crate) const TRIGGER_TEST_FINISHED: &str = "wiring-test-finished";
+pub const TRIGGER_TEST_FINISHED: &str = "wiring-test-finished";
 /// A delivery value the manual prints two ways (3.3 Pr15 default 20, 3.2 "±20 rpm",
 /// HPD-ERRATUM-005): a read at the start shows one of them.
-pub(crate) const TWO_WAY_DEFAULT: &str = "Pr15";
+pub const TWO_WAY_DEFAULT: &str = "Pr15";

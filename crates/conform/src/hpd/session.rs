@@ -714,7 +714,7 @@ impl Session for HpdSession<'_, '_> {
 
 impl HpdSession<'_, '_> {
     /// Restarts or reconnects the device; a fresh device also gets a fresh reference.
-    pub(crate) fn recover(&mut self) -> Result<Recovered, LinkError> {
+    pub fn recover(&mut self) -> Result<Recovered, LinkError> {
         let r = self.link.recover()?;
         if r == Recovered::Fresh {
             self.reset_oracle();
@@ -724,14 +724,14 @@ impl HpdSession<'_, '_> {
 
     /// The reference powered up afresh now (after a restarted process first answered: its
     /// power-up is closer to then than to the restart).
-    pub(crate) fn restart_reference(&mut self) {
+    pub fn restart_reference(&mut self) {
         self.reset_oracle();
     }
 
     /// Sends `bytes` (a read) to the device alone and waits for a whole answer (manual 4.1),
     /// unjudged: a just-started process is then talking (its start-up grace is over). True
     /// when bytes came.
-    pub(crate) fn wake(&mut self, bytes: &[u8]) -> bool {
+    pub fn wake(&mut self, bytes: &[u8]) -> bool {
         let window = self.window();
         let t0 = self.link.now();
         if self.link.send(bytes).is_err() {
@@ -755,7 +755,7 @@ impl HpdSession<'_, '_> {
     }
 
     /// Resets the device and the reference to the start state, when the transport can.
-    pub(crate) fn reset(&mut self) -> Result<bool, LinkError> {
+    pub fn reset(&mut self) -> Result<bool, LinkError> {
         let done = self.link.reset()?;
         if done {
             self.reset_oracle();
@@ -808,12 +808,7 @@ impl HpdSession<'_, '_> {
 
     /// Runs `case` (described by `info`) as [`Session::run`] runs a suite case, judged step
     /// by step against the reference; `from_start`: reset first on transports that can.
-    pub(crate) fn run_case(
-        &mut self,
-        info: &CaseInfo,
-        case: &HpdCase,
-        from_start: bool,
-    ) -> CaseRun {
+    pub fn run_case(&mut self, info: &CaseInfo, case: &HpdCase, from_start: bool) -> CaseRun {
         let suite = self.suite;
         let caps = self.link.caps();
         if case.needs_power_cycle && !caps.power_cycle {

@@ -1,31 +1,31 @@
 //! The steps of an HPD case: an HPD [`Action`] with its role, text and requirements.
 
 use drivespec_hpd::memory::Slot;
-pub(crate) use drivespec_hpd::step::{Compare, Step as Action};
+pub use drivespec_hpd::step::{Compare, Step as Action};
 
 /// One step of a case.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) struct Step {
+pub struct Step {
     /// Setup, check or cleanup.
-    pub(crate) role: crate::case::Role,
+    pub role: crate::case::Role,
     /// What to do.
-    pub(crate) action: Action,
+    pub action: Action,
     /// The answer a golden vector gives to an exchange (None: not from a vector;
     /// Some(empty): silence).
-    pub(crate) golden: Option<Vec<u8>>,
+    pub golden: Option<Vec<u8>>,
     /// One line.
-    pub(crate) text: String,
+    pub text: String,
     /// Requirements this step exercises.
-    pub(crate) requirements: Vec<String>,
+    pub requirements: Vec<String>,
 }
 
 /// An HPD case: the generic description plus the steps.
 #[derive(Debug, Clone)]
-pub(crate) struct HpdCase {
+pub struct HpdCase {
     /// The steps, setup first, cleanup last.
-    pub(crate) steps: Vec<Step>,
+    pub steps: Vec<Step>,
     /// Needs the transport to power-cycle the device.
-    pub(crate) needs_power_cycle: bool,
+    pub needs_power_cycle: bool,
     /// Parameter slots the case may change (resynchronised after a failure).
-    pub(crate) touched: Vec<Slot>,
+    pub touched: Vec<Slot>,
 }

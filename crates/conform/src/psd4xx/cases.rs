@@ -17,12 +17,12 @@ use drivespec_spec::{Access, DeviceModel, Family, FamilyId, Level, Parameter, Ve
 pub(crate) const PKW_MAX_CYCLES: u32 = 8;
 
 /// One step of a case.
-pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
+pub type StepDef = crate::cyclic_session::StepDef<Step>;
 
-pub(crate) use crate::cyclic_session::{OpenPoint, Tolerance, MOTION};
+pub use crate::cyclic_session::{OpenPoint, Tolerance, MOTION};
 
 /// Tolerance of the PKW and record cases: the answer may come one cycle late.
-pub(crate) const EXCHANGE: Tolerance = Tolerance {
+pub const EXCHANGE: Tolerance = Tolerance {
     cycles: 1,
     position: 0,
     speed: 0,
@@ -31,7 +31,7 @@ pub(crate) const EXCHANGE: Tolerance = Tolerance {
 
 /// A generated case.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct PsdCase {
+pub struct PsdCase {
     /// The steps.
     pub steps: Vec<StepDef>,
     /// Tolerances.
@@ -52,7 +52,7 @@ struct Gen<'a> {
 }
 
 /// Control-word values by their spec name (bitfield `control`, 4.1).
-pub(crate) fn control(family: &Family, name: &str) -> Result<u16, String> {
+pub fn control(family: &Family, name: &str) -> Result<u16, String> {
     family
         .bitfield("control")
         .and_then(|b| b.values.iter().find(|v| v.name == name))
@@ -61,7 +61,7 @@ pub(crate) fn control(family: &Family, name: &str) -> Result<u16, String> {
 }
 
 /// The control bit named `name` as a mask (bitfield `control`, 3.7).
-pub(crate) fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
+pub fn control_bit(family: &Family, name: &str) -> Result<u16, String> {
     family
         .bitfield("control")
         .and_then(|b| b.bits.iter().find(|x| x.name == name))

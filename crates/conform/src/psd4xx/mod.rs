@@ -23,12 +23,11 @@
 //! against another reading, reporting which; points the manual leaves open are reported, not
 //! judged.
 
-pub(crate) mod cases;
-pub(crate) mod fuzz;
+pub mod cases;
 mod scenario;
 mod session;
 
-pub(crate) use session::{Psd4xx, Psd4xxSession};
+pub use session::{Psd4xx, Psd4xxSession};
 
 use crate::case::CaseInfo;
 use crate::cyclic::{Peer, Server};
@@ -99,7 +98,7 @@ impl<'s> Psd4xxSuite<'s> {
     }
 
     /// A session on `peer` with the family's own operations (greeting, injections, fuzzing).
-    pub(crate) fn cyclic_session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psd4xxSession<'a, 's> {
+    pub fn cyclic_session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psd4xxSession<'a, 's> {
         Psd4xxSession::new(Psd4xx::new(self), peer)
     }
 
@@ -120,7 +119,8 @@ impl<'s> Psd4xxSuite<'s> {
         ))
     }
 
-    pub(crate) fn family(&self) -> &'s Family {
+    /// The PSD4xx family of the spec.
+    pub fn family(&self) -> &'s Family {
         self.family
     }
 
@@ -128,7 +128,8 @@ impl<'s> Psd4xxSuite<'s> {
         Some((self.infos.get(index)?, self.cases.get(index)?))
     }
 
-    pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
+    /// The peer of the device under test `dut` (`sim`: the suite's reference drive).
+    pub fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
         crate::cyclic_session::peer(dut, &self.reference.model.id, || self.server())
     }
 }

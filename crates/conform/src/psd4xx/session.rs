@@ -15,11 +15,11 @@ use drivespec_spec::{DataType, Family, FamilyId, Protocol};
 type ImageValue = fn(&Input) -> i64;
 
 /// A session on one device under test.
-pub(crate) type Psd4xxSession<'a, 's> = CyclicSession<'a, Psd4xx<'a, 's>>;
+pub type Psd4xxSession<'a, 's> = CyclicSession<'a, Psd4xx<'a, 's>>;
 
 /// The PSD4xx family as the cyclic session runs it: the suite's reference and cases.
 #[derive(Clone, Copy)]
-pub(crate) struct Psd4xx<'a, 's> {
+pub struct Psd4xx<'a, 's> {
     suite: &'a Psd4xxSuite<'s>,
 }
 

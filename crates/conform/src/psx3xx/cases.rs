@@ -33,12 +33,12 @@ mod isdu {
 }
 
 /// One step of a case.
-pub(crate) type StepDef = crate::cyclic_session::StepDef<Step>;
+pub type StepDef = crate::cyclic_session::StepDef<Step>;
 
-pub(crate) use crate::cyclic_session::{Tolerance, MOTION};
+pub use crate::cyclic_session::{Tolerance, MOTION};
 
 /// Tolerance of the ISDU cases: every cycle and every live value exact.
-pub(crate) const EXACT: Tolerance = Tolerance {
+pub const EXACT: Tolerance = Tolerance {
     cycles: 0,
     position: 0,
     speed: 0,
@@ -47,7 +47,7 @@ pub(crate) const EXACT: Tolerance = Tolerance {
 
 /// A generated case.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct PsxCase {
+pub struct PsxCase {
     /// The output the master sends before the first `Out` step: all zero in the delivery
     /// format.
     pub start: Output,

@@ -21,11 +21,10 @@
 //! except the live speed and position read by ISDU in a motion case, which must lie between
 //! the device's own process-data images around the read (within the case's tolerance).
 
-pub(crate) mod cases;
-pub(crate) mod fuzz;
+pub mod cases;
 mod session;
 
-pub(crate) use session::{Psx3xx, Psx3xxSession};
+pub use session::{output, Psx3xx, Psx3xxSession};
 
 use crate::case::CaseInfo;
 use crate::cyclic::{Peer, Server};
@@ -91,11 +90,12 @@ impl<'s> Psx3xxSuite<'s> {
     }
 
     /// A session on `peer` with the family's own operations (greeting, injections, fuzzing).
-    pub(crate) fn cyclic_session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psx3xxSession<'a, 's> {
+    pub fn cyclic_session<'a>(&'a self, peer: Box<dyn Peer + 'a>) -> Psx3xxSession<'a, 's> {
         Psx3xxSession::new(Psx3xx::new(self), peer)
     }
 
-    pub(crate) fn family(&self) -> &'s Family {
+    /// The PSx3xx family of the spec.
+    pub fn family(&self) -> &'s Family {
         self.family
     }
 
@@ -103,7 +103,8 @@ impl<'s> Psx3xxSuite<'s> {
         Some((self.infos.get(index)?, self.cases.get(index)?))
     }
 
-    pub(crate) fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer + '_>, SetupError> {
+    /// The peer of the device under test `dut` (`sim`: the suite's reference drive).
+    pub fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer + '_>, SetupError> {
         crate::cyclic_session::peer(dut, &self.reference.model.id, || self.server())
     }
 }

@@ -13,12 +13,12 @@ use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
 use drivespec_spec::{DataType, Family, FamilyId};
 
 /// A session on one device under test.
-pub(crate) type Psx3xxSession<'a, 's> = CyclicSession<'a, Psx3xx<'a, 's>>;
+pub type Psx3xxSession<'a, 's> = CyclicSession<'a, Psx3xx<'a, 's>>;
 
 /// The PSx3xx family as the cyclic session runs it: the suite's reference and cases, the
 /// running bit and the ISDU indices of the live values.
 #[derive(Clone)]
-pub(crate) struct Psx3xx<'a, 's> {
+pub struct Psx3xx<'a, 's> {
     suite: &'a Psx3xxSuite<'s>,
     running_bit: u16,
     /// ISDU indices of the live speed and position (3.3.2 `rpm`, `actual`), judged in a
@@ -351,7 +351,7 @@ pub(crate) fn env_request(t: u64, env: &str) -> Result<Request, WireError> {
 }
 
 /// The process output of a `pd-out` step (manual 3.3.1).
-pub(crate) fn output(format: u8, control: u16, target: i32, speed: i16, stamp: u16) -> Output {
+pub fn output(format: u8, control: u16, target: i32, speed: i16, stamp: u16) -> Output {
     match format {
         0 => Output::TimeStamp {
             control: TsCode(u8::try_from(control).unwrap_or(u8::MAX)),

@@ -1,6 +1,6 @@
 //! Shared test support: the HPD mutants (`mutants`), the PSD4xx mutants (`psd4xx_mutants`),
-//! the PSx3xx mutants (`psx3xx_mutants`) and the reference drive on a TCP port
-//! (`reference_server`, behind `faulty_relay.py`). Each test file uses only part of it.
+//! the PSx3xx mutants (`psx3xx_mutants`) (the fuzzer's tests in `crates/fuzz` use these three
+//! too) and the variants. Each test file uses only part of it.
 #![allow(
     dead_code,
     missing_docs,
@@ -17,4 +17,3 @@ pub mod psd4xx_mutants;
 pub mod psd4xx_variants;
 pub mod psx3xx_mutants;
 pub mod psx3xx_variants;
-pub mod reference_server;

@@ -1,6 +1,6 @@
 //! The HPD mutants: the reference drive with one planted deviation (a wrapper around `Drive`,
 //! or an erratum reading other than the adopted one), shared by the mutation test
-//! (`hpd_mutants.rs`) and the fuzzer tests (`fuzz_*.rs`).
+//! (`hpd_mutants.rs`) and the fuzzer tests (`crates/fuzz/tests/fuzz_*.rs`).
 
 use drivespec_conform::link::Micros;
 use drivespec_hpd::model::{Drive, DriveConfig, Output};

@@ -1,6 +1,6 @@
 //! The PSD4xx mutants: the reference drive with one planted deviation (a wrapper around
 //! `psd4xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
-//! test (`psd4xx_mutants.rs`) and the fuzzer test (`fuzz_psd4xx.rs`).
+//! test (`psd4xx_mutants.rs`) and the fuzzer test (`crates/fuzz/tests/fuzz_psd4xx.rs`).
 
 use super::mutants::spec;
 use drivespec_conform::cyclic::{CyclicDevice, Env};

@@ -1,6 +1,6 @@
 //! The PSx3xx mutants: the reference drive with one planted deviation (a wrapper around
 //! `psx3xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
-//! test (`psx3xx_mutants.rs`) and the fuzzer test (`fuzz_psx3xx.rs`).
+//! test (`psx3xx_mutants.rs`) and the fuzzer test (`crates/fuzz/tests/fuzz_psx3xx.rs`).
 
 use super::mutants::spec;
 use drivespec_conform::cyclic::{CyclicDevice, Env, Reply};

@@ -1,18 +1,18 @@
 //! The family-neutral fuzzing loop: generate a sequence, run it on the device and the
-//! reference, count what happened, and minimise every new finding (README "Fuzzing").
+//! reference, count what happened, and minimise every new finding (README "Verdicts, findings, minimisation").
 //!
 //! Determinism: the generator draws from one seeded [`Rng`] and never from the results, so
 //! the same seed sends the same sequences whatever the device does; on `sim` every run is on
 //! virtual time, so the findings and their replays are the same too. Wall-clock time only
 //! decides when `--duration` stops the loop.
 
-use super::ddmin::ddmin;
-use super::replay::{Action, FamilyStep, FindingClass, Start, Step};
-use super::stats::Stats;
-use crate::case::{CaseRun, Failure, Outcome, RequirementRef};
-use crate::link::{Caps, LinkError};
-use crate::rng::Rng;
+use crate::ddmin::ddmin;
+use crate::replay::{Action, FamilyStep, FindingClass, Start, Step};
+use crate::stats::Stats;
+use drivespec_conform::case::{CaseRun, Failure, Outcome, RequirementRef};
+use drivespec_conform::link::{Caps, LinkError};
 use drivespec_hpd::step::Step as HpdStep;
+use drivespec_sim::rng::Rng;
 use drivespec_spec::{Family, FamilyId, Level};
 
 /// What one run of a sequence found.
@@ -38,7 +38,7 @@ pub(crate) struct Fault {
 }
 
 /// One family's fuzzing: sequences from the spec, and runs against the device and the
-/// reference model (HPD in [`super::hpd`], PSD4xx in [`super::psd4xx`]).
+/// reference model (HPD in [`crate::hpd`], PSD4xx in [`crate::psd4xx`]).
 pub(crate) trait Target {
     /// The family.
     fn family(&self) -> FamilyId;

@@ -15,17 +15,17 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, Role};
-use crate::cyclic::Peer;
-use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
-use crate::fuzz::replay::Step;
-use crate::psx3xx::cases::{PsxCase, StepDef, EXACT, MOTION};
-use crate::psx3xx::session::output;
-use crate::psx3xx::{Psx3xx, Psx3xxSuite};
-use crate::rng::Rng;
-use crate::suite::SetupError;
+use crate::cyclic_target::{self, Bound, CyclicFuzz, CyclicTarget};
+use crate::replay::Step;
+use drivespec_conform::case::{CaseInfo, CaseRun, Role};
+use drivespec_conform::cyclic::Peer;
+use drivespec_conform::psx3xx::cases::{PsxCase, StepDef, EXACT, MOTION};
+use drivespec_conform::psx3xx::output;
+use drivespec_conform::psx3xx::{Psx3xx, Psx3xxSuite};
+use drivespec_conform::suite::SetupError;
 use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_psx3xx::{Input, Output, Stamp};
+use drivespec_sim::rng::Rng;
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Family, FamilyId, Level};
 use sequences::{PsxGen, ENV_KINDS};
@@ -72,6 +72,16 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
         kind(s)
     }
 
+    fn bound(s: &mut PsxStep) -> Option<Bound<'_>> {
+        match s {
+            PsxStep::Hold { cycles: c }
+            | PsxStep::Until { max: c, .. }
+            | PsxStep::IsduPoll { max: c, .. } => Some(Bound::Cycles(c)),
+            PsxStep::Advance { us } => Some(Bound::Micros(us)),
+            _ => None,
+        }
+    }
+
     fn spec(&self) -> &Family {
         self.suite.family()
     }
@@ -110,7 +120,7 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
                 .map(|(a, s)| StepDef {
                     role: Role::Check,
                     text: s.text.clone(),
-                    action: bounded(a),
+                    action: Self::bounded(a),
                 })
                 .collect(),
             tol: if moves { MOTION } else { EXACT },
@@ -133,7 +143,7 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
             return "reply".to_owned();
         }
         let d = self.suite.reference();
-        let image = |a: Option<&crate::case::Answer>| {
+        let image = |a: Option<&drivespec_conform::case::Answer>| {
             a.and_then(|a| parse_hex(&a.hex).ok())
                 .and_then(|b| Input::parse(d.rules(), d.byte_order(), &b).ok())
         };
@@ -181,32 +191,5 @@ fn kind(s: &PsxStep) -> String {
         PsxStep::IsduWrite { index, .. } => format!("isdu-write-{index}"),
         PsxStep::Env { env } => cyclic_target::env_signature(env),
         other => other.name().to_owned(),
-    }
-}
-
-/// A step within the bounds a replay file cannot exceed (most cycles of a wait, longest
-/// `advance`).
-fn bounded(s: &PsxStep) -> PsxStep {
-    match s {
-        PsxStep::Hold { cycles } => PsxStep::Hold {
-            cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
-        },
-        PsxStep::Until { running, max } => PsxStep::Until {
-            running: *running,
-            max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
-        },
-        PsxStep::Advance { us } => PsxStep::Advance {
-            us: (*us).min(cyclic_target::MAX_ADVANCE_US),
-        },
-        PsxStep::IsduPoll {
-            index,
-            subindex,
-            max,
-        } => PsxStep::IsduPoll {
-            index: *index,
-            subindex: *subindex,
-            max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
-        },
-        other => other.clone(),
     }
 }

@@ -8,16 +8,16 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
-use crate::fuzz::engine::{self, Fault, OtherFamilyStep, Target, Trial};
-use crate::fuzz::replay::{Action, FindingClass, Start, Step};
-use crate::hpd::step::{Action as HAction, HpdCase, Step as HStep};
-use crate::hpd::{GenError, HpdSession, HpdSuite};
-use crate::link::{Caps, Link, LinkError, Recovered};
-use crate::rng::Rng;
-use crate::suite::SetupError;
+use crate::engine::{self, Fault, OtherFamilyStep, Target, Trial};
+use crate::replay::{Action, FindingClass, Start, Step};
+use drivespec_conform::case::{CaseInfo, CaseRun, Outcome, RequirementRef, Role};
+use drivespec_conform::hpd::step::{Action as HAction, HpdCase, Step as HStep};
+use drivespec_conform::hpd::{GenError, HpdSession, HpdSuite};
+use drivespec_conform::link::{Caps, Link, LinkError, Recovered};
+use drivespec_conform::suite::SetupError;
 use drivespec_hpd::memory::Slot;
 use drivespec_hpd::{FrameRules, Message};
+use drivespec_sim::rng::Rng;
 use drivespec_spec::{Family, FamilyId, Level};
 use sequences::HpdGen;
 
@@ -163,7 +163,7 @@ impl Target for HpdTarget<'_, '_> {
     }
 
     fn describe(&self) -> String {
-        crate::suite::Session::describe(&self.session)
+        drivespec_conform::suite::Session::describe(&self.session)
     }
 
     fn caps(&self) -> Caps {

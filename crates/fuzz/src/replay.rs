@@ -1,5 +1,5 @@
 //! Fuzz inputs and the replay file (`drivespec-fuzz-replay/1`, JSON; described in
-//! `crates/conform/README.md`, "Fuzzing"): the steps of a sequence, what each exchange gave
+//! `crates/fuzz/README.md`, "Replay files"): the steps of a sequence, what each exchange gave
 //! when the file was written, and the finding it reproduces.
 //!
 //! A step is its family's step type (`drivespec_hpd::step::Step`,
@@ -10,9 +10,9 @@
 //! cyclic-exchange protocol does not know or a step without the fields its action needs are
 //! errors naming the step.
 
-use crate::case::Record;
-use crate::cyclic::Request;
-use crate::link::Micros;
+use drivespec_conform::case::Record;
+use drivespec_conform::cyclic::Request;
+use drivespec_conform::link::Micros;
 use drivespec_hpd::step::Step as HpdStep;
 use drivespec_psd4xx::step::Step as PsdStep;
 use drivespec_psx3xx::step::Step as PsxStep;
@@ -242,7 +242,7 @@ impl Observed {
     pub fn of(r: &Record, t0: Micros) -> Observed {
         // Cyclic records and injections travel as lines, not bytes: their lines are kept.
         let lines = r.sent.is_none() && r.sent_text.is_some();
-        let shown = |a: &crate::case::Answer| {
+        let shown = |a: &drivespec_conform::case::Answer| {
             if lines {
                 a.text.clone()
             } else {
@@ -609,7 +609,7 @@ mod tests {
 
     #[test]
     fn the_readme_example_loads() {
-        let readme = include_str!("../../README.md");
+        let readme = include_str!("../README.md");
         let from = readme.find("### Replay files").unwrap();
         let block = readme[from..].split("```json").nth(1).unwrap();
         let json = block.split("```").next().unwrap();

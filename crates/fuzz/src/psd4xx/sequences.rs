@@ -11,16 +11,16 @@
 //! environment changes interleave. Every value is drawn from the seeded [`Rng`] only; every
 //! requirement ID a step names is checked against the spec when the generator is built.
 
-use crate::cyclic::Env;
-use crate::fuzz::cyclic_target::env_kind;
-use crate::fuzz::engine::{self, below, chance, pick};
-use crate::fuzz::replay::{Action, Step};
-use crate::psd4xx::cases::{control, control_bit};
-use crate::psd4xx::Psd4xxSuite;
-use crate::rng::Rng;
+use crate::cyclic_target::env_kind;
+use crate::engine::{self, below, chance, pick};
+use crate::replay::{Action, Step};
+use drivespec_conform::cyclic::Env;
+use drivespec_conform::psd4xx::cases::{control, control_bit};
+use drivespec_conform::psd4xx::Psd4xxSuite;
 use drivespec_psd4xx::model::LinkEvent;
 use drivespec_psd4xx::step::{PkwBlock, Step as PsdStep};
 use drivespec_psd4xx::{PkwRequest, PkwRules, RecordRules, RecordWrite, Request, Width};
+use drivespec_sim::rng::Rng;
 use drivespec_spec::{Family, Parameter};
 
 /// Most steps in one sequence.
@@ -244,7 +244,7 @@ fn class(t: Template) -> &'static str {
 
 impl PsdGen {
     /// The generator for the suite's model, sending only the injections of the kinds in
-    /// `envs` ([`crate::fuzz::cyclic_target::env_kind`]); an error names what the spec lacks.
+    /// `envs` ([`crate::cyclic_target::env_kind`]); an error names what the spec lacks.
     pub(crate) fn new(suite: &Psd4xxSuite<'_>, envs: Vec<String>) -> Result<PsdGen, String> {
         let family: &Family = suite.family();
         let rules = suite.reference().rules();

@@ -1,15 +1,15 @@
 //! What the fuzz targets over the cyclic-exchange protocol (PSD4xx, PSx3xx) share: their
 //! capabilities, the bounds a replay file cannot exceed, the signature of a step and how a
-//! failed case run becomes a finding (README "Cyclic-exchange protocol", "Fuzzing").
+//! failed case run becomes a finding (`crates/cyclic/README.md`; README "Verdicts, findings, minimisation").
 
-use super::engine::{self, Fault, Target, Trial};
-use super::replay::{FamilyStep, FindingClass, Start, Step};
-use crate::case::{CaseInfo, CaseRun, Outcome, RequirementRef};
-use crate::cyclic::{Env, PeerError};
-use crate::cyclic_session::{CyclicFamily, CyclicSession};
-use crate::link::{Caps, LinkError};
-use crate::rng::Rng;
-use crate::suite::{Session, SetupError};
+use crate::engine::{self, Fault, Target, Trial};
+use crate::replay::{FamilyStep, FindingClass, Start, Step};
+use drivespec_conform::case::{CaseInfo, CaseRun, Outcome, RequirementRef};
+use drivespec_conform::cyclic::{Env, PeerError};
+use drivespec_conform::cyclic_session::{CyclicFamily, CyclicSession};
+use drivespec_conform::link::{Caps, LinkError};
+use drivespec_conform::suite::{Session, SetupError};
+use drivespec_sim::rng::Rng;
 use drivespec_spec::{Family, FamilyId, Level};
 
 /// Every run starts with `RESET` on the device and a fresh reference, on any transport; times
@@ -27,6 +27,14 @@ pub(crate) const MAX_STEP_CYCLES: u32 = 60_000;
 
 /// Longest `advance` step (10 min).
 pub(crate) const MAX_ADVANCE_US: u64 = 600_000_000;
+
+/// The part of a step a replay file bounds.
+pub(crate) enum Bound<'x> {
+    /// Most cycles of a wait (`hold`, `until`, a poll): at most [`MAX_STEP_CYCLES`].
+    Cycles(&'x mut u32),
+    /// The time of an `advance`: at most [`MAX_ADVANCE_US`].
+    Micros(&'x mut u64),
+}
 
 /// The kind of an injection: the first word of its `ENV` text (`jam`, `link`, …).
 pub(crate) fn env_kind(env: &str) -> String {
@@ -92,7 +100,7 @@ pub(crate) trait CyclicFuzz<'s> {
     /// The family the session runs.
     type Family: CyclicFamily<'s>;
     /// The family's step type.
-    type Step: FamilyStep;
+    type Step: FamilyStep + Clone;
     /// A new sequence.
     fn generate(&mut self, rng: &mut Rng) -> Vec<Step>;
     /// The case a sequence runs as; `own` holds the family step of each of `steps`.
@@ -105,6 +113,18 @@ pub(crate) trait CyclicFuzz<'s> {
     fn differs(&self, run: &CaseRun, step: usize) -> String;
     /// The signature name of a step.
     fn kind(s: &Self::Step) -> String;
+    /// The part of a step a replay file bounds, if it has one.
+    fn bound(s: &mut Self::Step) -> Option<Bound<'_>>;
+    /// A step within the bounds a replay file cannot exceed.
+    fn bounded(s: &Self::Step) -> Self::Step {
+        let mut s = s.clone();
+        match Self::bound(&mut s) {
+            Some(Bound::Cycles(c)) => *c = (*c).min(MAX_STEP_CYCLES),
+            Some(Bound::Micros(us)) => *us = (*us).min(MAX_ADVANCE_US),
+            None => {}
+        }
+        s
+    }
     /// The family's spec.
     fn spec(&self) -> &Family;
 }

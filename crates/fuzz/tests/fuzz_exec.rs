@@ -12,8 +12,8 @@
 mod support;
 
 use drivespec_conform::dut::Dut;
-use drivespec_conform::fuzz::{self, FindingClass, Options};
 use drivespec_conform::Progress;
+use drivespec_fuzz::{self as fuzz, FindingClass, Options};
 use std::path::PathBuf;
 use std::time::Duration;
 use support::mutants::spec;

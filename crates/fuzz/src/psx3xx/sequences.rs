@@ -15,15 +15,15 @@
 //! [`Rng`] only; every requirement ID a step names is checked against the spec when the
 //! generator is built.
 
-use crate::cyclic::Env;
-use crate::fuzz::engine::{self, below, chance, pick};
-use crate::fuzz::replay::{Action, Step};
-use crate::psx3xx::Psx3xxSuite;
-use crate::rng::Rng;
+use crate::engine::{self, below, chance, pick};
+use crate::replay::{Action, Step};
+use drivespec_conform::cyclic::Env;
+use drivespec_conform::psx3xx::Psx3xxSuite;
 use drivespec_psd4xx::model::LinkEvent;
 use drivespec_psx3xx::isdu::{Target, Value};
 use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_psx3xx::{Guards, Rules};
+use drivespec_sim::rng::Rng;
 use drivespec_spec::psx3xx::{FormatEffect, StateCommand};
 use drivespec_spec::{Access, Family, Readings};
 

@@ -15,9 +15,9 @@ mod support;
 
 use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::dut::Dut;
-use drivespec_conform::fuzz::{self, Action, Device, FindingClass, Options, Replay};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
+use drivespec_fuzz::{self as fuzz, Action, Device, FindingClass, Options, Replay};
 use drivespec_spec::FamilyId;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

@@ -3,11 +3,11 @@
 //! and the replay command; the JSON adds a `fuzz` section with the statistics, the HTML a
 //! statistics section, the JUnit file properties.
 
-use super::engine::Found;
-use super::replay::Replay;
-use super::stats::Stats;
-use crate::case::{CaseRun, Failure, RequirementRef};
-use crate::report::{
+use crate::engine::Found;
+use crate::replay::Replay;
+use crate::stats::Stats;
+use drivespec_conform::case::{CaseRun, Failure, RequirementRef};
+use drivespec_conform::report::{
     self, CaseRef, CaseReport, Counts, Coverage, CoverageRow, FamilyCoverage, Report, RunInfo,
     Status, Tool,
 };

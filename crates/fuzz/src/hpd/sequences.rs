@@ -2,24 +2,24 @@
 //! parameter at, inside and beyond its range, malformed frames, bit changes, commands, PLC
 //! programs good and bad, the conformance suite's own cases as seeds, and environment
 //! changes where the transport offers them. Each step carries its generator class (README
-//! "Fuzzing", table of classes) and the requirement IDs it exercises.
+//! "What is generated (HPD)") and the requirement IDs it exercises.
 //!
 //! The generator draws only from the [`Rng`] it is given; nothing here reads a clock or the
 //! device. Nothing panics: a message that cannot be built is skipped.
 
-use crate::case::Role;
-use crate::fuzz::engine::{below, chance, pick};
-use crate::fuzz::replay::{self, Step};
-use crate::hpd::cases::{BitRef, CaseB, Gen, GenError};
-use crate::hpd::frame::frame;
-use crate::hpd::names;
-use crate::hpd::step::{Action, Compare, Step as SuiteStep};
-use crate::hpd::HpdSuite;
-use crate::link::{Caps, Micros};
-use crate::rng::Rng;
+use crate::engine::{below, chance, pick};
+use crate::replay::{self, Step};
+use drivespec_conform::case::Role;
+use drivespec_conform::hpd::cases::{BitRef, CaseB, Gen, GenError};
+use drivespec_conform::hpd::frame::frame;
+use drivespec_conform::hpd::names;
+use drivespec_conform::hpd::step::{Action, Compare, Step as SuiteStep};
+use drivespec_conform::hpd::HpdSuite;
+use drivespec_conform::link::{Caps, Micros};
 use drivespec_hpd::memory::Slot;
 use drivespec_hpd::plc::{Instr, Operands};
 use drivespec_hpd::{Data, Message, MessageKind};
+use drivespec_sim::rng::Rng;
 use drivespec_spec::hpd::{OperandForm, Operation};
 use drivespec_spec::{Access, Parameter};
 
@@ -40,7 +40,7 @@ struct Bit<'s> {
     reqs: Vec<&'s str>,
 }
 
-/// The templates a sequence is made of, with their weights (README "Fuzzing").
+/// The templates a sequence is made of, with their weights (README "What is generated (HPD)").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Template {
     Read,
@@ -806,7 +806,11 @@ impl<'a, 's> HpdGen<'a, 's> {
             return;
         };
         let base = self.g.base(s);
-        let v = crate::hpd::cases::sign_for(s, base ^ (1 + u32::from(rng.byte())), self.g.family);
+        let v = drivespec_conform::hpd::cases::sign_for(
+            s,
+            base ^ (1 + u32::from(rng.byte())),
+            self.g.family,
+        );
         self.write_slot(out, "read-only-write", s, v, &p.id);
         let linked = self.linked(p);
         self.tag(out, linked.iter().map(String::as_str));

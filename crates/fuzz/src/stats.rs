@@ -1,8 +1,8 @@
 //! What a campaign counts (the `fuzz` section of the report, README "Fuzz reports"): inputs
 //! by generator class, judged answers by verdict, requirement IDs touched, findings.
 
-use super::engine::Trial;
-use super::replay::{FindingClass, Step};
+use crate::engine::Trial;
+use crate::replay::{FindingClass, Step};
 use drivespec_spec::FamilyId;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -103,7 +103,7 @@ impl Stats {
     }
 
     /// Keeps a transport error outside sequences (the first 100).
-    pub(crate) fn transport_error(&mut self, e: &crate::link::LinkError) {
+    pub(crate) fn transport_error(&mut self, e: &drivespec_conform::link::LinkError) {
         if self.transport_errors.len() < 100 {
             self.transport_errors.push(e.to_string());
         }

@@ -1,5 +1,5 @@
 //! `drivespec fuzz`: stateful, spec-aware black-box fuzzing of a device under test, judged by
-//! the same differential oracle as `drivespec conform` (README "Fuzzing").
+//! the same differential oracle as `drivespec conform` (`crates/fuzz/README.md`).
 //!
 //! - [`run`] (or [`run_on`] with a link of the caller's) generates sequences from the spec
 //!   (valid, boundary and malformed requests, commands, PLC programs, environment changes),
@@ -15,15 +15,20 @@
 //! device that dies or hangs is a finding, and the run goes on after restarting it. Nothing
 //! here panics on any device behaviour or replay file.
 //!
-//! HPD (`hpd` target, serial frames), PSD4xx (`psd4xx` target) and PSx3xx (`psx3xx` target),
-//! both over the cyclic-exchange protocol; each implements the crate-internal `Target`
-//! (`engine.rs`) with its generator and the family's conformance session.
+//! HPD ([`hpd`], serial frames), PSD4xx ([`psd4xx`]) and PSx3xx ([`psx3xx`]), the last two
+//! over the cyclic-exchange protocol; each implements the crate-internal `Target`
+//! (`engine.rs`) with its generator and the family's conformance session of
+//! `drivespec-conform`.
+#![forbid(unsafe_code)]
 
-pub(crate) mod cyclic_target;
+mod cyclic_target;
 mod ddmin;
-pub(crate) mod engine;
+mod engine;
+mod hpd;
 mod output;
-pub(crate) mod replay;
+mod psd4xx;
+mod psx3xx;
+mod replay;
 mod stats;
 
 pub use output::{json as report_json, Finding};
@@ -32,16 +37,16 @@ pub use replay::{
 };
 pub use stats::{FindingSummary, Stats, STATS_SCHEMA};
 
-use crate::case::CaseRun;
-use crate::cyclic::{LinkPeer, Peer};
-use crate::dut::{shell_quote, Dut};
-use crate::hpd::HpdSuite;
-use crate::link::Link;
-use crate::psd4xx::Psd4xxSuite;
-use crate::psx3xx::Psx3xxSuite;
-use crate::report::{self, Report};
-use crate::runner::Progress;
-use crate::suite::{Settings, SetupError};
+use drivespec_conform::case::CaseRun;
+use drivespec_conform::cyclic::{LinkPeer, Peer};
+use drivespec_conform::dut::{shell_quote, Dut};
+use drivespec_conform::hpd::HpdSuite;
+use drivespec_conform::link::Link;
+use drivespec_conform::psd4xx::Psd4xxSuite;
+use drivespec_conform::psx3xx::Psx3xxSuite;
+use drivespec_conform::report::{self, Report};
+use drivespec_conform::runner::Progress;
+use drivespec_conform::suite::{Settings, SetupError};
 use drivespec_spec::{FamilyId, Spec};
 use engine::{Event, Found, Limits, Target};
 use std::io::Write;
@@ -185,7 +190,7 @@ fn effective(opts: &Options) -> Settings {
 pub enum Device {
     /// A byte link: HPD frames, or `drivespec-cyclic/1` lines for PSD4xx and PSx3xx.
     Link(Box<dyn Link>),
-    /// A cyclic-exchange peer (PSD4xx, PSx3xx): e.g. a [`crate::cyclic::LocalPeer`] on a test
+    /// A cyclic-exchange peer (PSD4xx, PSx3xx): e.g. a [`drivespec_conform::cyclic::LocalPeer`] on a test
     /// device.
     Peer(Box<dyn Peer>),
 }
@@ -214,7 +219,7 @@ fn with_target<R>(
                 }
                 None => suite.link(&opts.dut)?,
             };
-            let mut target = crate::hpd::fuzz::HpdTarget::new(&suite, link)?;
+            let mut target = crate::hpd::HpdTarget::new(&suite, link)?;
             f(&mut target)
         }
         FamilyId::Psd4xx => {
@@ -224,7 +229,7 @@ fn with_target<R>(
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
                 None => suite.peer(&opts.dut)?,
             };
-            let mut target = crate::psd4xx::fuzz::target(&suite, peer)?;
+            let mut target = crate::psd4xx::target(&suite, peer)?;
             f(&mut target)
         }
         FamilyId::Psx3xx => {
@@ -234,7 +239,7 @@ fn with_target<R>(
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
                 None => suite.peer(&opts.dut)?,
             };
-            let mut target = crate::psx3xx::fuzz::target(&suite, peer)?;
+            let mut target = crate::psx3xx::target(&suite, peer)?;
             f(&mut target)
         }
     }

@@ -11,9 +11,9 @@
 
 mod support;
 
-use drivespec_conform::fuzz::{self, FindingClass, Options};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
+use drivespec_fuzz::{self as fuzz, FindingClass, Options};
 use drivespec_sim::SimLink;
 use support::mutants::{mutants, spec, strict_readings, Kind, Mutant};
 

@@ -11,8 +11,8 @@
 mod support;
 
 use drivespec_conform::dut::Dut;
-use drivespec_conform::fuzz::{self, Action, Options, Replay, Step};
 use drivespec_conform::Progress;
+use drivespec_fuzz::{self as fuzz, Action, Options, Replay, Step};
 use drivespec_hpd::step::{Compare, Step as HpdStep};
 use drivespec_sim::SimLink;
 use std::path::PathBuf;

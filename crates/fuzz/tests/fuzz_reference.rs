@@ -9,8 +9,8 @@
 
 mod support;
 
-use drivespec_conform::fuzz::{self, Options};
 use drivespec_conform::Progress;
+use drivespec_fuzz::{self as fuzz, Options};
 use support::mutants::spec;
 
 fn opts(seed: u64, iterations: u64) -> Options {

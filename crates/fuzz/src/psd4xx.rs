@@ -15,16 +15,16 @@
 
 mod sequences;
 
-use crate::case::{CaseInfo, CaseRun, Role};
-use crate::cyclic::Peer;
-use crate::fuzz::cyclic_target::{self, CyclicFuzz, CyclicTarget};
-use crate::fuzz::replay::Step;
-use crate::psd4xx::cases::{PsdCase, StepDef, EXCHANGE, MOTION};
-use crate::psd4xx::{Psd4xx, Psd4xxSuite};
-use crate::rng::Rng;
-use crate::suite::SetupError;
+use crate::cyclic_target::{self, Bound, CyclicFuzz, CyclicTarget};
+use crate::replay::Step;
+use drivespec_conform::case::{CaseInfo, CaseRun, Role};
+use drivespec_conform::cyclic::Peer;
+use drivespec_conform::psd4xx::cases::{PsdCase, StepDef, EXCHANGE, MOTION};
+use drivespec_conform::psd4xx::{Psd4xx, Psd4xxSuite};
+use drivespec_conform::suite::SetupError;
 use drivespec_psd4xx::step::Step as PsdStep;
 use drivespec_psd4xx::Input;
+use drivespec_sim::rng::Rng;
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Family, FamilyId, Level};
 use sequences::{PsdGen, ENV_KINDS};
@@ -61,6 +61,14 @@ impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
 
     fn kind(s: &PsdStep) -> String {
         kind(s)
+    }
+
+    fn bound(s: &mut PsdStep) -> Option<Bound<'_>> {
+        match s {
+            PsdStep::Hold { cycles: c } | PsdStep::Until { max: c, .. } => Some(Bound::Cycles(c)),
+            PsdStep::Advance { us } => Some(Bound::Micros(us)),
+            _ => None,
+        }
     }
 
     fn spec(&self) -> &Family {
@@ -101,7 +109,7 @@ impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
                 .map(|(a, s)| StepDef {
                     role: Role::Check,
                     text: s.text.clone(),
-                    action: bounded(a),
+                    action: Self::bounded(a),
                 })
                 .collect(),
             tol: if moves { MOTION } else { EXCHANGE },
@@ -126,7 +134,7 @@ impl<'a, 's> CyclicFuzz<'static> for PsdFuzz<'a, 's> {
             return "reply".to_owned();
         }
         let rules = self.suite.reference().rules();
-        let image = |a: Option<&crate::case::Answer>| {
+        let image = |a: Option<&drivespec_conform::case::Answer>| {
             a.and_then(|a| parse_hex(&a.hex).ok())
                 .and_then(|b| Input::parse(rules, &b).ok())
         };
@@ -168,23 +176,5 @@ fn kind(s: &PsdStep) -> String {
         PsdStep::Pkw { pkw } => format!("pkw-ak{}", pkw.ak),
         PsdStep::Env { env } => cyclic_target::env_signature(env),
         other => other.name().to_owned(),
-    }
-}
-
-/// A step within the bounds a replay file cannot exceed (most cycles of a wait, longest
-/// `advance`).
-fn bounded(s: &PsdStep) -> PsdStep {
-    match s {
-        PsdStep::Hold { cycles } => PsdStep::Hold {
-            cycles: (*cycles).min(cyclic_target::MAX_STEP_CYCLES),
-        },
-        PsdStep::Until { running, max } => PsdStep::Until {
-            running: *running,
-            max: (*max).min(cyclic_target::MAX_STEP_CYCLES),
-        },
-        PsdStep::Advance { us } => PsdStep::Advance {
-            us: (*us).min(cyclic_target::MAX_ADVANCE_US),
-        },
-        other => other.clone(),
     }
 }
