@@ -1,4 +1,4 @@
-//! cargo-fuzz target `script_psd4xx`: see `drivespec_fuzz::script::psd4xx`.
+//! cargo-fuzz target `script_psd4xx`: see `drivespec_fuzz_targets::script::psd4xx`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz::script::psd4xx(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| drivespec_fuzz_targets::script::psd4xx(data));
