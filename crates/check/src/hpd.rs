@@ -15,7 +15,7 @@
 //! b99.7 is not known to be set; a write to Pb99 (commands) forgets every expectation.
 
 use crate::error::SetupError;
-use crate::report::{Catalog, Evidence, Recorder, Report, Stats, StreamStats, Where};
+use crate::report::{Catalog, Evidence, Policy, Recorder, Report, Stats, StreamStats, Where};
 use drivespec_capture::serial::{Origin, SerialChunk, SerialError};
 use drivespec_hpd::memory::ParamMap;
 use drivespec_hpd::plc::{PlcCodec, PlcError, ProgramIssue};
@@ -376,6 +376,9 @@ impl<'s> HpdChecker<'s> {
                 details: BTreeMap::from([("address".to_owned(), serde_json::Value::from(*addr))]),
             });
         }
+        let r = self.rec.report();
+        r.scope("HPD", Some("hpd"), None);
+        r.judge(Policy::default());
         self.rec.finish()
     }
 

@@ -14,7 +14,7 @@
 
 use crate::error::SetupError;
 use crate::report::{
-    Catalog, DriveInfo, Evidence, InputFault, Recorder, Report, Stats, StreamStats, Where,
+    Catalog, DriveInfo, Evidence, InputFault, Policy, Recorder, Report, Stats, StreamStats, Where,
 };
 use crate::timeline::{Sample, Timeline};
 use drivespec_capture::iolink::{Access, IoLinkError, IoLinkEvent, IoLinkKind, IsduResult};
@@ -911,6 +911,9 @@ impl<'s> IoLinkChecker<'s> {
             }
             r.timelines.push(p.timeline);
         }
+        let r = self.rec.report();
+        r.scope("PSx3xx", Some("psx3xx"), None);
+        r.judge(Policy::default());
         self.rec.finish()
     }
 }

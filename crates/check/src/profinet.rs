@@ -16,7 +16,7 @@ use crate::error::SetupError;
 use crate::locate::{self, Binding, Buffered, StreamKey};
 use crate::psd4xx::{PsdDrive, PsdOptions};
 use crate::report::{
-    Catalog, DriveInfo, Evidence, InputFault, Recorder, Report, Stats, StreamStats, Where,
+    Catalog, DriveInfo, Evidence, InputFault, Policy, Recorder, Report, Stats, StreamStats, Where,
 };
 use drivespec_capture::dcerpc::Uuid;
 use drivespec_capture::link::LinkError;
@@ -42,6 +42,12 @@ pub const MAX_ARS: usize = 64;
 pub const SEARCH_FRAMES: usize = 4000;
 /// Capture time (µs) after the first cyclic frame within which the search buffers frames.
 pub const SEARCH_US: u64 = 10_000_000;
+
+/// Why a provider in STOP from its first frame is no violation of PN-RT-DS-002.
+const STARTUP_STOP: &str = "start-up: a provider reports STOP (DataStatus.ProviderState = 0) until its application runs; an IO controller sends STOP from its first cyclic frame until its program runs after ApplicationReady (IEC 61158-6-10 APDU_Status DataStatus bit 4)";
+
+/// Why a bad IOPS of a provider in STOP is no violation of PN-IO-IOPS-001.
+const BAD_IN_STOP: &str = "a provider in STOP marks its data bad (IOPS = Bad: CPU in \"Stop\" state, bus description 3.9; IEC 61158-6-10 IOxS)";
 
 /// µs per cycle counter unit (IEC 61158-6-10: 31.25 µs).
 const COUNT_NS: u64 = 31_250;
@@ -95,6 +101,10 @@ pub struct PnOptions {
     pub module_ident: Option<u32>,
     /// Search the cyclic frames for PSD4xx process data when no Connect describes them.
     pub search: bool,
+    /// The input can be read a second time: a drive the search finds late is checked from
+    /// the capture's start in a second pass ([`PnChecker::replay_pdu`]) instead of from the
+    /// frames buffered when it was found.
+    pub rescan: bool,
 }
 
 impl Default for PnOptions {
@@ -105,6 +115,7 @@ impl Default for PnOptions {
             manual: None,
             module_ident: None,
             search: true,
+            rescan: false,
         }
     }
 }
@@ -138,6 +149,12 @@ struct Stream {
     valid_seen: bool,
     invalid: bool,
     stop: bool,
+    /// The provider has been in RUN: a STOP after it is a finding, before it start-up.
+    run_seen: bool,
+    /// The listed start-up STOP, to be ended when the provider goes to RUN.
+    stop_allowed: Option<usize>,
+    /// IOxS offsets whose bad value is listed as allowed (provider in STOP), to be ended.
+    iox_allowed: Vec<(usize, Option<usize>)>,
     problem: bool,
     reserved: bool,
     transfer: bool,
@@ -199,6 +216,18 @@ pub struct PnChecker<'s> {
     drives: Vec<Located<'s>>,
     search: Option<Vec<Buffered>>,
     search_start: Option<u64>,
+    /// Batches searched without finding anything.
+    batches: u64,
+    /// Cyclic frames searched without finding anything.
+    searched: u64,
+    /// After a fruitless batch: the last C_SDU of each stream; the next batch starts when
+    /// one changes (an idle drive starts to move or to talk).
+    watch: HashMap<StreamKey, Vec<u8>, BuildFx>,
+    /// Drives found in a later batch, to be checked from the capture's start in a second
+    /// pass over the input.
+    late: Vec<locate::Found>,
+    /// Where the first of the late drives was found.
+    late_at: Option<Where>,
     pending_records: HashMap<(Uuid, u16), PendingRecord>,
     cyclic_frames: u64,
     connects_without_psd: u64,
@@ -302,6 +331,11 @@ impl<'s> PnChecker<'s> {
             drives: Vec::new(),
             search: (options.search && options.manual.is_none()).then(Vec::new),
             search_start: None,
+            batches: 0,
+            searched: 0,
+            watch: HashMap::with_hasher(BuildFx),
+            late: Vec::new(),
+            late_at: None,
             pending_records: HashMap::new(),
             cyclic_frames: 0,
             connects_without_psd: 0,
@@ -550,6 +584,9 @@ impl<'s> PnChecker<'s> {
                         valid_seen: false,
                         invalid: false,
                         stop: false,
+                        run_seen: false,
+                        stop_allowed: None,
+                        iox_allowed: Vec::new(),
                         problem: false,
                         reserved: false,
                         transfer: false,
@@ -564,7 +601,7 @@ impl<'s> PnChecker<'s> {
         let mut found = Vec::new();
         let mut label = String::new();
         if let Some((_, s)) = self.streams.get_mut(idx) {
-            stream_frame(s, &at, data, apdu, &mut found);
+            stream_frame(s, &at, data, apdu, &mut found, &mut self.rec);
             if !found.is_empty() {
                 label = s.label.clone();
             }
@@ -575,8 +612,11 @@ impl<'s> PnChecker<'s> {
         // PSD4xx images in this frame.
         let olen = Output::buffer_len(&self.rules);
         let ilen = Input::buffer_len(&self.rules);
+        // Bus description 3.9: with IOPS bad (CPU in STOP) the drive keeps the last valid
+        // outputs, so such an output image is not one the drive acts on.
+        let valid = apdu.data_status.provider_run() && apdu.data_status.data_valid();
         for d in self.drives.iter_mut() {
-            if d.out.matches(&key) {
+            if d.out.matches(&key) && valid && output_good(&d.out, data) {
                 if let Some(w) = data.get(d.out.offset..d.out.offset + olen) {
                     d.drive.output(&mut self.rec, at, w);
                 }
@@ -587,13 +627,34 @@ impl<'s> PnChecker<'s> {
                 }
             }
         }
-        self.buffer_for_search(key, data, at);
+        self.buffer_for_search(key, data, at, valid);
     }
 
-    fn buffer_for_search(&mut self, key: StreamKey, data: &[u8], at: Where) {
+    fn buffer_for_search(&mut self, key: StreamKey, data: &[u8], at: Where, valid: bool) {
         let Some(buf) = self.search.as_mut() else {
             return;
         };
+        if buf.is_empty() && self.batches > 0 {
+            // Between batches: wait until a stream's data change.
+            let changed = match self.watch.get_mut(&key) {
+                Some(last) if last.as_slice() == data => false,
+                Some(last) => {
+                    last.clear();
+                    last.extend_from_slice(data);
+                    true
+                }
+                None => {
+                    if self.watch.len() < MAX_STREAMS {
+                        self.watch.insert(key, data.to_vec());
+                    }
+                    false
+                }
+            };
+            if !changed {
+                return;
+            }
+            self.search_start = None;
+        }
         if let Some(t) = at.time {
             self.search_start.get_or_insert(t);
         }
@@ -605,13 +666,17 @@ impl<'s> PnChecker<'s> {
             key,
             data: data.to_vec(),
             at,
+            valid,
         });
         if buf.len() >= SEARCH_FRAMES || elapsed >= SEARCH_US {
             self.run_search();
         }
     }
 
-    /// Runs the search on the buffered frames and replays them to the drives found.
+    /// Searches the buffered frames (a batch); the drives found are checked from the
+    /// capture's start: by replaying the buffer when it is the capture's first batch,
+    /// else in a second pass when the input allows it ([`PnOptions::rescan`]), else from
+    /// the batch on.
     fn run_search(&mut self) {
         let Some(buf) = self.search.take() else {
             return;
@@ -619,21 +684,46 @@ impl<'s> PnChecker<'s> {
         if !self.drives.is_empty() {
             return;
         }
-        if buf.is_empty() {
-            self.rec
-                .report()
-                .note("no PSD4xx found: no Connect with PSD4xx modules and no cyclic frames");
-            return;
-        }
-        let found = locate::search(&self.rules, &buf);
+        let found = if buf.is_empty() {
+            Vec::new()
+        } else {
+            locate::search(&self.rules, &buf)
+        };
         if found.is_empty() {
-            self.rec.report().note(format!(
-                "no PSD4xx found: no Connect with PSD4xx modules, and the search over the first {} cyclic frames found no window that behaves like PSD4xx process data (give --frame-id and --offset to check anyway)",
-                buf.len()
-            ));
+            self.searched += buf.len() as u64;
+            self.batches += 1;
+            // Keep searching later batches, watching for changes from the last frames on.
+            for b in buf.iter().rev() {
+                if self.watch.len() >= MAX_STREAMS {
+                    break;
+                }
+                self.watch.entry(b.key).or_insert_with(|| b.data.clone());
+            }
+            let mut buf = buf;
+            buf.clear();
+            self.search = Some(buf);
             return;
         }
-        for f in &found {
+        let first = self.batches == 0;
+        let at = buf.first().map(|b| b.at);
+        if !first && self.options.rescan {
+            self.late = found;
+            self.late_at = at;
+            return;
+        }
+        if !first {
+            if let Some(w) = at {
+                self.rec.report().note(format!(
+                    "PSD4xx found in the frames from {w} on; the input cannot be read twice, so the drive checks start there"
+                ));
+            }
+        }
+        self.add_found(&found);
+        self.replay(&buf);
+    }
+
+    fn add_found(&mut self, found: &[locate::Found]) {
+        for f in found {
             let details = BTreeMap::from([
                 (
                     "out_frame_id".to_owned(),
@@ -649,12 +739,16 @@ impl<'s> PnChecker<'s> {
             ]);
             self.add_drive(f.out, f.inp, None, "search", f.confidence, details);
         }
+    }
+
+    /// Feeds buffered frames to the drives.
+    fn replay(&mut self, buf: &[Buffered]) {
         let olen = Output::buffer_len(&self.rules);
         let ilen = Input::buffer_len(&self.rules);
-        for b in &buf {
+        for b in buf {
             let at = b.at;
             for d in self.drives.iter_mut() {
-                if d.out.matches(&b.key) {
+                if d.out.matches(&b.key) && b.valid && output_good(&d.out, &b.data) {
                     if let Some(w) = b.data.get(d.out.offset..d.out.offset + olen) {
                         d.drive.output(&mut self.rec, at, w);
                     }
@@ -663,6 +757,61 @@ impl<'s> PnChecker<'s> {
                     if let Some(w) = b.data.get(d.inp.offset..d.inp.offset + ilen) {
                         d.drive.input(&mut self.rec, at, w);
                     }
+                }
+            }
+        }
+    }
+
+    /// Whether drives were found late and wait for a second pass over the input
+    /// ([`PnChecker::replay_pdu`] for every record from the start, then
+    /// [`PnChecker::finish`]).
+    pub fn wants_second_pass(&self) -> bool {
+        !self.late.is_empty()
+    }
+
+    /// Starts the second pass: the drives found late are checked from here on.
+    pub fn begin_second_pass(&mut self) {
+        let late = std::mem::take(&mut self.late);
+        if let Some(w) = self.late_at {
+            self.rec.report().note(format!(
+                "PSD4xx found in the frames from {w} on; its checks ran from the capture's start in a second pass"
+            ));
+        }
+        self.add_found(&late);
+    }
+
+    /// One record of the second pass: only the drives' images are checked (the generic
+    /// checks ran in the first pass).
+    pub fn replay_pdu(&mut self, record: u64, time: Option<u64>, pdu: &Result<Pdu<'_>, PduError>) {
+        let Ok(Pdu::Rt { frame, link, .. }) = pdu else {
+            return;
+        };
+        let Ok(c) = frame.cyclic() else {
+            return;
+        };
+        let key: StreamKey = (
+            c.frame_id.0,
+            link.src.unwrap_or([0; 6]),
+            link.dst.unwrap_or([0; 6]),
+        );
+        let at = Where {
+            event: 0,
+            frame: Some(record),
+            time,
+            ..Where::default()
+        };
+        let valid = c.apdu.data_status.provider_run() && c.apdu.data_status.data_valid();
+        let olen = Output::buffer_len(&self.rules);
+        let ilen = Input::buffer_len(&self.rules);
+        for d in self.drives.iter_mut() {
+            if d.out.matches(&key) && valid && output_good(&d.out, c.data) {
+                if let Some(w) = c.data.get(d.out.offset..d.out.offset + olen) {
+                    d.drive.output(&mut self.rec, at, w);
+                }
+            }
+            if d.inp.matches(&key) {
+                if let Some(w) = c.data.get(d.inp.offset..d.inp.offset + ilen) {
+                    d.drive.input(&mut self.rec, at, w);
                 }
             }
         }
@@ -1062,9 +1211,36 @@ impl<'s> PnChecker<'s> {
         });
     }
 
+    /// Ends the first pass over the input: searches the frames still buffered. Then
+    /// [`PnChecker::wants_second_pass`] tells whether a second pass is due.
+    pub fn end_of_input(&mut self) {
+        self.run_search();
+    }
+
     /// Ends the capture; `counts` are the reader's frame counts, when known.
     pub fn finish(mut self, counts: Option<Counts>) -> Report {
         self.run_search();
+        if !self.late.is_empty() {
+            let late = std::mem::take(&mut self.late);
+            self.add_found(&late);
+            if let Some(w) = self.late_at {
+                self.rec.report().note(format!(
+                    "PSD4xx found in the frames from {w} on, but the input was not read a second time: its checks did not run"
+                ));
+            }
+        } else if self.drives.is_empty() && self.options.search && self.options.manual.is_none() {
+            let searched = self.searched;
+            let note = if searched == 0 {
+                "no PSD4xx found: no Connect with PSD4xx modules and no cyclic frames".to_owned()
+            } else {
+                format!(
+                    "no PSD4xx found: no Connect with PSD4xx modules, and the search over {searched} cyclic frames (the capture's first frames and every later stretch in which the data changed) found no window that behaves like PSD4xx process data (give --frame-id and --offset to check anyway)"
+                )
+            };
+            if self.connects_without_psd == 0 || searched > 0 {
+                self.rec.report().note(note);
+            }
+        }
         let mut streams: Vec<(StreamKey, Stream)> = std::mem::take(&mut self.streams);
         streams.sort_by_key(|(k, _)| *k);
         let drives = std::mem::take(&mut self.drives);
@@ -1110,8 +1286,19 @@ impl<'s> PnChecker<'s> {
         if r.drives.is_empty() && !r.notes.iter().any(|n| n.starts_with("no PSD4xx")) {
             r.note("no PSD4xx found in this capture; only the generic PROFINET checks ran");
         }
+        r.scope("PROFINET", None, None);
+        let why_not = r.drives.is_empty().then(|| "no drive found".to_owned());
+        r.scope("PSD4xx", Some("psd4xx"), why_not);
+        r.judge(Policy::default());
         self.rec.finish()
     }
+}
+
+/// Whether the provider status (IOPS) of the output module `b` in `data` is good, or unknown.
+fn output_good(b: &Binding, data: &[u8]) -> bool {
+    b.iops
+        .and_then(|o| data.get(o))
+        .is_none_or(|iops| iops & 0x80 != 0)
 }
 
 /// The generic checks of one cyclic frame of stream `s`.
@@ -1121,6 +1308,7 @@ fn stream_frame(
     data: &[u8],
     apdu: ApduStatus,
     found: &mut Vec<(&'static str, String, Evidence)>,
+    rec: &mut Recorder,
 ) {
     s.frames += 1;
     let counter = apdu.cycle_counter;
@@ -1224,7 +1412,27 @@ fn stream_frame(
     s.invalid = invalid;
     let stop = !ds.provider_run();
     if stop && !s.stop {
-        found.push(("PN-RT-DS-002", "provider in STOP".into(), ev()));
+        if s.run_seen {
+            found.push((
+                "PN-RT-DS-002",
+                "provider went from RUN to STOP".into(),
+                ev(),
+            ));
+        } else {
+            s.stop_allowed = rec.allowed(
+                "PN-RT-DS-002",
+                &s.label,
+                *at,
+                "provider in STOP from its first frame (start-up)",
+                STARTUP_STOP,
+            );
+        }
+    }
+    if !stop {
+        if let Some(i) = s.stop_allowed.take() {
+            rec.ended(i, *at);
+        }
+        s.run_seen = true;
     }
     s.stop = stop;
     let problem = !ds.station_ok();
@@ -1288,11 +1496,29 @@ fn stream_frame(
         let good = b & 0x80 != 0;
         let was = s.iox.insert(offset, good);
         if !good && was.is_some_and(|g| g) && s.valid_seen {
-            found.push((
-                id,
-                format!("{label} = {b:#04x} (bad)"),
-                ev().with("offset", offset).with("iox", format!("{b:#04x}")),
-            ));
+            if stop {
+                let listed = rec.allowed(
+                    id,
+                    &s.label,
+                    *at,
+                    format!("{label} = {b:#04x} (bad) while the provider is in STOP"),
+                    BAD_IN_STOP,
+                );
+                s.iox_allowed.push((offset, listed));
+            } else {
+                found.push((
+                    id,
+                    format!("{label} = {b:#04x} (bad)"),
+                    ev().with("offset", offset).with("iox", format!("{b:#04x}")),
+                ));
+            }
+        }
+        if good && was.is_some_and(|g| !g) {
+            if let Some(k) = s.iox_allowed.iter().position(|(o, _)| *o == offset) {
+                if let (_, Some(i)) = s.iox_allowed.swap_remove(k) {
+                    rec.ended(i, *at);
+                }
+            }
         }
     }
 }
