@@ -5,12 +5,15 @@
 //!
 //! [`check`] is a pure function over `drivespec_capture::profinet::PnEvent`s (style rule
 //! 12); [`PnChecker`] is the same as a push API. Memory is bounded whatever the capture size:
-//! at most [`MAX_STREAMS`] streams, [`MAX_ARS`] application relations and
-//! [`SEARCH_FRAMES`] buffered frames for the search; everything else is per stream or per
-//! drive. Nothing here panics.
+//! at most [`MAX_STREAMS`] streams, [`MAX_ARS`] application relations,
+//! [`SEARCH_FRAMES`] buffered frames for the search and one C_SDU per stream to watch for
+//! changes between search batches; everything else is per stream or per drive. Nothing here
+//! panics.
 //!
 //! Conditions are reported when they start (a transition), not on every frame: a provider
-//! in STOP for an hour is one violation, with the frame where it began.
+//! that goes to STOP for an hour is one finding, with the frame where it began. States the
+//! standard allows (a provider in STOP from its first frame, bad IOPS while the provider is
+//! in STOP) are listed as allowed states with their start and end.
 
 use crate::error::SetupError;
 use crate::locate::{self, Binding, Buffered, StreamKey};
