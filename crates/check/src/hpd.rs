@@ -691,7 +691,11 @@ impl<'s> HpdChecker<'s> {
                 } else {
                     "HPD-FRAME-010"
                 },
-                format!("{found:?} answer where {expected:?} is due"),
+                format!(
+                    "{} where {} is due",
+                    answer_words(found),
+                    answer_words(expected)
+                ),
             ),
         };
         self.rec.violation(id, &subject, at, msg, ev);
@@ -1021,4 +1025,13 @@ pub fn continues(e: &SerialError) -> bool {
             | SerialError::LinkType { .. }
             | SerialError::RtacHeader { .. }
     )
+}
+
+/// An answer kind in words (manual 4.1 table).
+fn answer_words(a: Answer) -> &'static str {
+    match a {
+        Answer::None => "no answer",
+        Answer::Data => "a data answer",
+        Answer::Ack => "a short acknowledge",
+    }
 }

@@ -1355,12 +1355,16 @@ fn stream_frame(
                     ));
                 } else {
                     let steps = u64::from(delta / inc);
-                    if steps > 1 {
+                    // Frames missing: the cycles the counter skipped, unless the capture
+                    // time shows fewer passed (a counter glitch loses no frame).
+                    let nominal = u64::from(inc) * COUNT_NS / 1000;
+                    let by_time = dt.map(|d| (d + nominal / 2) / nominal.max(1));
+                    let cycles = by_time.map_or(steps, |t| steps.min(t.max(1)));
+                    if cycles > 1 {
                         s.gaps += 1;
-                        s.missing += steps - 1;
+                        s.missing += cycles - 1;
                     }
                     if let Some(d) = dt {
-                        let nominal = u64::from(inc) * COUNT_NS / 1000;
                         s.jitter.add((d as f64 - (steps * nominal) as f64).abs());
                         let expected = u64::from(delta) * COUNT_NS / 1000;
                         if d > expected * 2 + 4000 || d + 4000 < expected / 2 {

@@ -922,7 +922,7 @@ impl<'s> PsdDrive<'s> {
                         "PSD-PAR-RANGE-001",
                         at,
                         format!(
-                            "par {pnu} ({}) reads {value}, outside its range {r:?}",
+                            "par {pnu} ({}) reads {value}, outside its range {r}",
                             p.name
                         ),
                         ev.clone().with("value", value),

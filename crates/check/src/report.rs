@@ -224,7 +224,8 @@ pub struct StreamStats {
     /// |interval − nominal| in µs.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub jitter_us: Option<Stats>,
-    /// Frames missing by the cycle counter (sum over gaps).
+    /// Frames missing: cycles the counter skipped, at most as many as the capture time shows
+    /// passed (sum over gaps).
     pub missing: u64,
     /// Gaps (places where at least one frame is missing).
     pub gaps: u64,
