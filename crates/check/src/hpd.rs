@@ -300,6 +300,31 @@ impl<'s> HpdChecker<'s> {
         self.rec.report().note(format!("skipped: {error}"));
     }
 
+    /// The recording reads Pr26 = `code` at `at`: without `--baud`, the message time-outs
+    /// of that line speed (manual 4 table) are checked from there on.
+    fn line_speed_read(&mut self, code: u8, at: Where) {
+        if self.timeout.is_some() || !self.times_known {
+            return;
+        }
+        let Some(rate) = self.family.hpd().and_then(|p| p.baud_rate(code)) else {
+            return;
+        };
+        let t = u64::from(rate.timeout_ms) * 1000;
+        let decoder = std::mem::replace(&mut self.decoder, LineDecoder::new(self.rules.clone()));
+        self.decoder = decoder.with_timeout(t);
+        self.timeout = Some(t);
+        self.answer_delay = rate.answer_delay_ms.map(|d| u64::from(d) * 1000);
+        self.rec.checks(CHECKED_TIMEOUT);
+        if self.answer_delay.is_some() {
+            self.rec.checks(&["HPD-BAUD-004"]);
+        }
+        let line = format!(
+            "line: Pr26 code {} = {} b/s, message time-out {} ms (manual 4 table), read from the recording at {at}: time-outs checked from there on",
+            rate.code, rate.bps, rate.timeout_ms
+        );
+        self.rec.report().detection.push(line);
+    }
+
     /// Ends the line and returns the report.
     pub fn finish(mut self) -> Report {
         let mut events = Vec::new();
@@ -925,6 +950,7 @@ impl<'s> HpdChecker<'s> {
             if let Some(b) = byte_at(s.addr) {
                 if self.pr26_hint.is_none() {
                     self.pr26_hint = Some((u32::from(b), at));
+                    self.line_speed_read(b, at);
                 }
             }
         }
