@@ -783,9 +783,29 @@ impl<'s> PnChecker<'s> {
         self.add_found(&late);
     }
 
-    /// One record of the second pass: only the drives' images are checked (the generic
-    /// checks ran in the first pass).
+    /// One record of the second pass: only the drives' images and record reads and writes
+    /// are checked (the generic checks ran in the first pass).
     pub fn replay_pdu(&mut self, record: u64, time: Option<u64>, pdu: &Result<Pdu<'_>, PduError>) {
+        if let Ok(Pdu::Rpc {
+            message: Some(Ok(m)),
+            link,
+            ..
+        }) = pdu
+        {
+            if matches!(
+                m.operation,
+                Operation::Read | Operation::Write | Operation::ReadImplicit
+            ) {
+                let o = Origin {
+                    record,
+                    time,
+                    src: link.src,
+                    dst: link.dst,
+                };
+                self.record(&o, m);
+            }
+            return;
+        }
         let Ok(Pdu::Rt { frame, link, .. }) = pdu else {
             return;
         };

@@ -159,12 +159,13 @@ pub fn text(reports: &[Report]) -> String {
                 }
             }
         }
-        observations(&mut o, "allowed states", &r.allowed, r.allowed_count);
+        observations(&mut o, "allowed states", &r.allowed, r.allowed_count, true);
         observations(
             &mut o,
             "inconclusive",
             &r.inconclusive,
             r.inconclusive_count,
+            false,
         );
         for n in &r.notes {
             let _ = writeln!(o, "  note: {n}");
@@ -202,8 +203,9 @@ pub fn text(reports: &[Report]) -> String {
     o
 }
 
-/// Lists allowed states or inconclusive checks: start, end, duration, what and why.
-fn observations(o: &mut String, title: &str, list: &[Observation], count: u64) {
+/// Lists allowed states (`spans`: with start, end and duration) or inconclusive checks
+/// (where), what and why.
+fn observations(o: &mut String, title: &str, list: &[Observation], count: u64, spans: bool) {
     if count == 0 {
         return;
     }
@@ -214,10 +216,11 @@ fn observations(o: &mut String, title: &str, list: &[Observation], count: u64) {
     };
     let _ = writeln!(o, "  {title}{more}:");
     for x in list {
-        let span = match (&x.end, x.duration_us) {
-            (Some(e), Some(d)) => format!("{} to {e} ({})", x.start, duration(d)),
-            (Some(e), None) => format!("{} to {e}", x.start),
-            (None, _) => format!("{} to the end of the capture", x.start),
+        let span = match (&x.end, x.duration_us, spans) {
+            (_, _, false) => x.start.to_string(),
+            (Some(e), Some(d), true) => format!("{} to {e} ({})", x.start, duration(d)),
+            (Some(e), None, true) => format!("{} to {e}", x.start),
+            (None, _, true) => format!("{} to the end of the capture", x.start),
         };
         let _ = writeln!(
             o,

@@ -147,7 +147,9 @@ fn a_drive_idle_for_3_s_is_found_and_checked() {
     let _ = std::fs::remove_file(&path);
     let file = file.unwrap();
     assert_eq!(file.drives.len(), 1, "{:?}", file.notes);
-    assert_eq!(counts(&file).get("PSD-CTL-13-001"), Some(&1));
+    let want: BTreeMap<String, u64> = [("PSD-CTL-13-001".to_owned(), 1)].into();
+    assert_eq!(counts(&file), want, "{:#?}", file.violations);
+    assert_eq!(counts(&once), want, "{:#?}", once.violations);
     assert!(
         file.notes.iter().any(|n| n.contains("second pass")),
         "{:?}",

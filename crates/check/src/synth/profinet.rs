@@ -524,6 +524,9 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
         ..PkwRequest::default()
     };
     let mut last_in = drive.input();
+    let mut last_valid = Output::default()
+        .to_bytes(&rules)
+        .map_err(|e| SynthError(e.to_string()))?;
     let mut forced_toggle: Option<u32> = None;
     let mut abort_masked = false;
     let mut cycle: u64 = 0;
@@ -612,18 +615,22 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
             let out_bytes = out
                 .to_bytes(&rules)
                 .map_err(|e| SynthError(e.to_string()))?;
-            // The model runs on its own clock from power-up; the capture on wall-clock time.
-            let mt = t - START;
-            drive
-                .handle_image(mt, &out_bytes)
-                .map_err(|e| SynthError(e.to_string()))?;
-            drive.advance(mt + 500);
-            while drive.poll_input().is_some() {}
-            while drive.poll_event().is_some() {}
             let stopped = cycle <= u64::from(scenario.startup_stop)
                 || (scenario.stop_during_run
                     && matches!(step, Step::Run(_))
                     && (10..60).contains(&step_cycles));
+            // With the controller in STOP the drive keeps the last valid outputs (3.9).
+            if !stopped {
+                last_valid.clone_from(&out_bytes);
+            }
+            // The model runs on its own clock from power-up; the capture on wall-clock time.
+            let mt = t - START;
+            drive
+                .handle_image(mt, &last_valid)
+                .map_err(|e| SynthError(e.to_string()))?;
+            drive.advance(mt + 500);
+            while drive.poll_input().is_some() {}
+            while drive.poll_event().is_some() {}
             let mut c_sdu = if stopped {
                 vec![0; out_bytes.len()]
             } else {
