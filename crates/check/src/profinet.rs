@@ -158,6 +158,9 @@ struct Stream {
     stop_allowed: Option<usize>,
     /// IOxS offsets whose bad value is listed as allowed (provider in STOP), to be ended.
     iox_allowed: Vec<(usize, Option<usize>)>,
+    /// Listed violations of the open conditions (DS-001, DS-002, DS-003, DS-004, TS-001,
+    /// LEN-001), to be ended.
+    open: [Option<usize>; 6],
     problem: bool,
     reserved: bool,
     transfer: bool,
@@ -590,6 +593,7 @@ impl<'s> PnChecker<'s> {
                         run_seen: false,
                         stop_allowed: None,
                         iox_allowed: Vec::new(),
+                        open: [None; 6],
                         problem: false,
                         reserved: false,
                         transfer: false,
@@ -1317,6 +1321,33 @@ impl<'s> PnChecker<'s> {
     }
 }
 
+/// A condition `k` of a stream (DataStatus, TransferStatus, length): a violation when it
+/// starts (`now` and not `was`), ended with its duration when it stops.
+#[allow(clippy::too_many_arguments)]
+fn condition(
+    rec: &mut Recorder,
+    label: &str,
+    open: &mut [Option<usize>; 6],
+    k: usize,
+    now: bool,
+    was: bool,
+    at: &Where,
+    what: &dyn Fn() -> (&'static str, String),
+    ev: &dyn Fn() -> Evidence,
+) {
+    let Some(slot) = open.get_mut(k) else {
+        return;
+    };
+    if now && !was {
+        let (id, message) = what();
+        *slot = rec.violation(id, label, *at, message, ev());
+    } else if !now && was {
+        if let Some(i) = slot.take() {
+            rec.violation_ended(i, *at);
+        }
+    }
+}
+
 /// Whether the provider status (IOPS) of the output module `b` in `data` is good, or unknown.
 fn output_good(b: &Binding, data: &[u8]) -> bool {
     b.iops
@@ -1423,37 +1454,66 @@ fn stream_frame(
         }
     }
     s.last = time.map(|t| (counter, t, *at)).or(Some((counter, 0, *at)));
-    // DataStatus and TransferStatus: report when a condition starts.
+    // DataStatus and TransferStatus: report when a condition starts, end it when it stops.
     let valid = ds.data_valid();
     if valid {
         s.valid_seen = true;
     }
     let invalid = s.valid_seen && !valid;
-    if invalid && !s.invalid {
-        found.push((
-            "PN-RT-DS-001",
-            "DataValid cleared after valid data".into(),
-            ev(),
-        ));
-    }
-    s.invalid = invalid;
+    let label = s.label.clone();
+    let mut cond = |k: usize, now: bool, was: bool, what: &dyn Fn() -> (&'static str, String)| {
+        condition(rec, &label, &mut s.open, k, now, was, at, what, &ev);
+    };
+    cond(0, invalid, s.invalid, &|| {
+        ("PN-RT-DS-001", "DataValid cleared after valid data".into())
+    });
     let stop = !ds.provider_run();
-    if stop && !s.stop {
-        if s.run_seen {
-            found.push((
-                "PN-RT-DS-002",
-                "provider went from RUN to STOP".into(),
-                ev(),
-            ));
-        } else {
-            s.stop_allowed = rec.allowed(
-                "PN-RT-DS-002",
-                &s.label,
-                *at,
-                "provider in STOP from its first frame (start-up)",
-                STARTUP_STOP,
-            );
-        }
+    cond(1, stop && s.run_seen, s.stop && s.run_seen, &|| {
+        ("PN-RT-DS-002", "provider went from RUN to STOP".into())
+    });
+    let problem = !ds.station_ok();
+    cond(2, problem, s.problem, &|| {
+        (
+            "PN-RT-DS-003",
+            "StationProblemIndicator signals a problem".into(),
+        )
+    });
+    let reserved = ds.reserved() != 0;
+    cond(3, reserved, s.reserved, &|| {
+        (
+            "PN-RT-DS-004",
+            format!("reserved DataStatus bits {:#04x} set", ds.reserved()),
+        )
+    });
+    let transfer = apdu.transfer_status != 0;
+    cond(4, transfer, s.transfer, &|| {
+        (
+            "PN-RT-TS-001",
+            format!("TransferStatus {:#04x}", apdu.transfer_status),
+        )
+    });
+    let short = s
+        .info
+        .as_ref()
+        .is_some_and(|info| data.len() < info.data_length);
+    let announced = s.info.as_ref().map_or(0, |i| i.data_length);
+    cond(5, short, s.short, &|| {
+        (
+            "PN-RT-LEN-001",
+            format!(
+                "{} byte(s) of data where the Connect announced a C_SDU of {announced}",
+                data.len()
+            ),
+        )
+    });
+    if stop && !s.stop && !s.run_seen {
+        s.stop_allowed = rec.allowed(
+            "PN-RT-DS-002",
+            &s.label,
+            *at,
+            "provider in STOP from its first frame (start-up)",
+            STARTUP_STOP,
+        );
     }
     if !stop {
         if let Some(i) = s.stop_allowed.take() {
@@ -1461,50 +1521,15 @@ fn stream_frame(
         }
         s.run_seen = true;
     }
+    s.invalid = invalid;
     s.stop = stop;
-    let problem = !ds.station_ok();
-    if problem && !s.problem {
-        found.push((
-            "PN-RT-DS-003",
-            "StationProblemIndicator signals a problem".into(),
-            ev(),
-        ));
-    }
     s.problem = problem;
-    let reserved = ds.reserved() != 0;
-    if reserved && !s.reserved {
-        found.push((
-            "PN-RT-DS-004",
-            format!("reserved DataStatus bits {:#04x} set", ds.reserved()),
-            ev(),
-        ));
-    }
     s.reserved = reserved;
-    let transfer = apdu.transfer_status != 0;
-    if transfer && !s.transfer {
-        found.push((
-            "PN-RT-TS-001",
-            format!("TransferStatus {:#04x}", apdu.transfer_status),
-            ev(),
-        ));
-    }
     s.transfer = transfer;
+    s.short = short;
     let Some(info) = s.info.as_ref() else {
         return;
     };
-    let short = data.len() < info.data_length;
-    if short && !s.short {
-        found.push((
-            "PN-RT-LEN-001",
-            format!(
-                "{} byte(s) of data where the Connect announced a C_SDU of {}",
-                data.len(),
-                info.data_length
-            ),
-            ev(),
-        ));
-    }
-    s.short = short;
     // IOxS: bit 7 DataState good (0x80).
     let positions: Vec<(String, usize, &'static str)> = info
         .iops

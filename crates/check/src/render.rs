@@ -136,9 +136,14 @@ pub fn text(reports: &[Report]) -> String {
             };
             let _ = writeln!(o, "  violations{capped}:");
             for v in &r.violations {
+                let until = match (&v.end, v.duration_us) {
+                    (Some(e), Some(d)) => format!(" (until {e}: {})", duration(d)),
+                    (Some(e), None) => format!(" (until {e})"),
+                    (None, _) => String::new(),
+                };
                 let _ = writeln!(
                     o,
-                    "    {} {} — {}: {}",
+                    "    {} {} — {}: {}{until}",
                     v.at, v.requirement, v.subject, v.message
                 );
                 if let Some(b) = &v.evidence.bytes {

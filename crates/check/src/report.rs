@@ -151,6 +151,12 @@ pub struct Violation {
     pub message: String,
     /// What shows it.
     pub evidence: Evidence,
+    /// Where a condition ended, when it ended before the capture did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end: Option<Where>,
+    /// The condition's duration in µs, when both ends have a time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duration_us: Option<u64>,
 }
 
 /// How often a requirement was checked and violated.
@@ -714,7 +720,7 @@ impl Recorder {
             })
     }
 
-    /// Records a violation of requirement `id`.
+    /// Records a violation of requirement `id`; gives its index in the listing, if listed.
     pub fn violation(
         &mut self,
         id: &str,
@@ -722,7 +728,7 @@ impl Recorder {
         at: Where,
         message: impl Into<String>,
         evidence: Evidence,
-    ) {
+    ) -> Option<usize> {
         self.report.violation_count += 1;
         let t = self.tally(id);
         t.violations += 1;
@@ -743,7 +749,22 @@ impl Recorder {
                 at,
                 message: message.into(),
                 evidence,
+                end: None,
+                duration_us: None,
             });
+            return Some(self.report.violations.len() - 1);
+        }
+        None
+    }
+
+    /// Ends the condition of the violation listed at `index` at `end`.
+    pub fn violation_ended(&mut self, index: usize, end: Where) {
+        if let Some(v) = self.report.violations.get_mut(index) {
+            v.duration_us = match (v.at.time, end.time) {
+                (Some(a), Some(b)) => Some(b.saturating_sub(a)),
+                _ => None,
+            };
+            v.end = Some(end);
         }
     }
 

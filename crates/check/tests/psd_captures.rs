@@ -200,6 +200,10 @@ fn a_controller_in_stop_is_no_violation() {
     assert_eq!(counts(&r), want, "{:#?}", r.violations);
     assert_eq!(r.must_count(), 0);
     assert_eq!(r.verdict, Verdict::Warn);
+    // The STOP after RUN is a condition with an end and a duration (50 cycles).
+    let stop = &r.violations[0];
+    assert!(stop.end.is_some(), "{stop:?}");
+    assert_eq!(stop.duration_us, Some(50_000), "{stop:?}");
     let startup = r
         .allowed
         .iter()
