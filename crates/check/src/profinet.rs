@@ -930,11 +930,19 @@ impl<'s> PnChecker<'s> {
             (Some(a), Some(b)) => format!("{} → {}", mac(&a), mac(&b)),
             _ => "PNIO-CM".into(),
         };
+        let decode = match s.decode {
+            0x80 => " (PNIORW)",
+            0x81 => " (PNIO)",
+            _ => "",
+        };
         self.rec.violation(
             "PN-CM-002",
             &subject,
             at,
-            format!("{what} answered with PNIOStatus {s}"),
+            format!(
+                "{what} answered with PNIOStatus {s}: ErrorCode {:#04x}, ErrorDecode {:#04x}{decode}, ErrorCode1 {:#04x}, ErrorCode2 {:#04x}",
+                s.code, s.decode, s.code1, s.code2
+            ),
             Evidence::none().with("pnio_status", s.to_string()),
         );
     }
