@@ -15,7 +15,7 @@
 //! b99.7 is not known to be set; a write to Pb99 (commands) forgets every expectation.
 
 use crate::error::SetupError;
-use crate::report::{Catalog, Evidence, Recorder, Report, Stats, StreamStats, Where};
+use crate::report::{Catalog, Evidence, Policy, Recorder, Report, Stats, StreamStats, Where};
 use drivespec_capture::serial::{Origin, SerialChunk, SerialError};
 use drivespec_hpd::memory::ParamMap;
 use drivespec_hpd::plc::{PlcCodec, PlcError, ProgramIssue};
@@ -300,6 +300,31 @@ impl<'s> HpdChecker<'s> {
         self.rec.report().note(format!("skipped: {error}"));
     }
 
+    /// The recording reads Pr26 = `code` at `at`: without `--baud`, the message time-outs
+    /// of that line speed (manual 4 table) are checked from there on.
+    fn line_speed_read(&mut self, code: u8, at: Where) {
+        if self.timeout.is_some() || !self.times_known {
+            return;
+        }
+        let Some(rate) = self.family.hpd().and_then(|p| p.baud_rate(code)) else {
+            return;
+        };
+        let t = u64::from(rate.timeout_ms) * 1000;
+        let decoder = std::mem::replace(&mut self.decoder, LineDecoder::new(self.rules.clone()));
+        self.decoder = decoder.with_timeout(t);
+        self.timeout = Some(t);
+        self.answer_delay = rate.answer_delay_ms.map(|d| u64::from(d) * 1000);
+        self.rec.checks(CHECKED_TIMEOUT);
+        if self.answer_delay.is_some() {
+            self.rec.checks(&["HPD-BAUD-004"]);
+        }
+        let line = format!(
+            "line: Pr26 code {} = {} b/s, message time-out {} ms (manual 4 table), read from the recording at {at}: time-outs checked from there on",
+            rate.code, rate.bps, rate.timeout_ms
+        );
+        self.rec.report().detection.push(line);
+    }
+
     /// Ends the line and returns the report.
     pub fn finish(mut self) -> Report {
         let mut events = Vec::new();
@@ -376,6 +401,9 @@ impl<'s> HpdChecker<'s> {
                 details: BTreeMap::from([("address".to_owned(), serde_json::Value::from(*addr))]),
             });
         }
+        let r = self.rec.report();
+        r.scope("HPD", Some("hpd"), None);
+        r.judge(Policy::default());
         self.rec.finish()
     }
 
@@ -688,7 +716,11 @@ impl<'s> HpdChecker<'s> {
                 } else {
                     "HPD-FRAME-010"
                 },
-                format!("{found:?} answer where {expected:?} is due"),
+                format!(
+                    "{} where {} is due",
+                    answer_words(found),
+                    answer_words(expected)
+                ),
             ),
         };
         self.rec.violation(id, &subject, at, msg, ev);
@@ -918,6 +950,7 @@ impl<'s> HpdChecker<'s> {
             if let Some(b) = byte_at(s.addr) {
                 if self.pr26_hint.is_none() {
                     self.pr26_hint = Some((u32::from(b), at));
+                    self.line_speed_read(b, at);
                 }
             }
         }
@@ -1018,4 +1051,13 @@ pub fn continues(e: &SerialError) -> bool {
             | SerialError::LinkType { .. }
             | SerialError::RtacHeader { .. }
     )
+}
+
+/// An answer kind in words (manual 4.1 table).
+fn answer_words(a: Answer) -> &'static str {
+    match a {
+        Answer::None => "no answer",
+        Answer::Data => "a data answer",
+        Answer::Ack => "a short acknowledge",
+    }
 }

@@ -14,7 +14,7 @@
 
 use crate::error::SetupError;
 use crate::report::{
-    Catalog, DriveInfo, Evidence, InputFault, Recorder, Report, Stats, StreamStats, Where,
+    Catalog, DriveInfo, Evidence, InputFault, Policy, Recorder, Report, Stats, StreamStats, Where,
 };
 use crate::timeline::{Sample, Timeline};
 use drivespec_capture::iolink::{Access, IoLinkError, IoLinkEvent, IoLinkKind, IsduResult};
@@ -658,12 +658,14 @@ impl<'s> IoLinkChecker<'s> {
         let (ri, rs) = req.address();
         if index.is_some_and(|i| i != ri) || subindex.is_some_and(|s| s != rs) {
             self.rec.report().note(format!(
-                "port {port}: ISDU response at {at} names index {index:?}/{subindex:?}, the request at {req_at} {ri}/{rs}"
+                "port {port}: ISDU response at {at} names index {}/{}, the request at {req_at} {ri}/{rs}",
+                index.map_or_else(|| "?".to_owned(), |i| i.to_string()),
+                subindex.map_or_else(|| "?".to_owned(), |i| i.to_string())
             ));
             return;
         }
         let ev = Evidence::none()
-            .with("request", format!("{req:?}"))
+            .with("request", request_words(&req))
             .with("request_at", req_at.to_string())
             .with(
                 "response",
@@ -804,7 +806,7 @@ impl<'s> IoLinkChecker<'s> {
                     };
                     found.push((
                         id,
-                        format!("ISDU {index} ({}) reads {v}, outside {r:?}", p.name),
+                        format!("ISDU {index} ({}) reads {v}, outside {r}", p.name),
                     ));
                 }
             }
@@ -911,6 +913,9 @@ impl<'s> IoLinkChecker<'s> {
             }
             r.timelines.push(p.timeline);
         }
+        let r = self.rec.report();
+        r.scope("PSx3xx", Some("psx3xx"), None);
+        r.judge(Policy::default());
         self.rec.finish()
     }
 }
@@ -966,4 +971,16 @@ fn early_start(
             ),
         )
     })
+}
+
+/// An ISDU request in words: `write index 2/0: 63`, `read index 24/0`.
+fn request_words(req: &Request) -> String {
+    match req {
+        Request::Read { index, subindex } => format!("read index {index}/{subindex}"),
+        Request::Write {
+            index,
+            subindex,
+            data,
+        } => format!("write index {index}/{subindex}: {}", to_hex(data)),
+    }
 }

@@ -25,5 +25,6 @@ pub mod timeline;
 
 pub use error::SetupError;
 pub use report::{
-    Catalog, Evidence, Report, Violation, Where, DEFAULT_MAX_VIOLATIONS, MAX_LISTED_PER_REQUIREMENT,
+    Catalog, Evidence, Observation, Policy, Report, Scope, Verdict, Violation, Where,
+    DEFAULT_MAX_VIOLATIONS, MAX_LISTED_PER_REQUIREMENT,
 };

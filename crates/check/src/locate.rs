@@ -63,6 +63,8 @@ pub struct Buffered {
     pub data: Vec<u8>,
     /// Where it is in the capture.
     pub at: crate::report::Where,
+    /// Whether its provider was in RUN with valid data (DataStatus).
+    pub valid: bool,
 }
 
 /// A PSD4xx found by the search.

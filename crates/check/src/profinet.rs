@@ -5,18 +5,21 @@
 //!
 //! [`check`] is a pure function over `drivespec_capture::profinet::PnEvent`s (style rule
 //! 12); [`PnChecker`] is the same as a push API. Memory is bounded whatever the capture size:
-//! at most [`MAX_STREAMS`] streams, [`MAX_ARS`] application relations and
-//! [`SEARCH_FRAMES`] buffered frames for the search; everything else is per stream or per
-//! drive. Nothing here panics.
+//! at most [`MAX_STREAMS`] streams, [`MAX_ARS`] application relations,
+//! [`SEARCH_FRAMES`] buffered frames for the search and one C_SDU per stream to watch for
+//! changes between search batches; everything else is per stream or per drive. Nothing here
+//! panics.
 //!
 //! Conditions are reported when they start (a transition), not on every frame: a provider
-//! in STOP for an hour is one violation, with the frame where it began.
+//! that goes to STOP for an hour is one finding, with the frame where it began. States the
+//! standard allows (a provider in STOP from its first frame, bad IOPS while the provider is
+//! in STOP) are listed as allowed states with their start and end.
 
 use crate::error::SetupError;
 use crate::locate::{self, Binding, Buffered, StreamKey};
 use crate::psd4xx::{PsdDrive, PsdOptions};
 use crate::report::{
-    Catalog, DriveInfo, Evidence, InputFault, Recorder, Report, Stats, StreamStats, Where,
+    Catalog, DriveInfo, Evidence, InputFault, Policy, Recorder, Report, Stats, StreamStats, Where,
 };
 use drivespec_capture::dcerpc::Uuid;
 use drivespec_capture::link::LinkError;
@@ -42,6 +45,12 @@ pub const MAX_ARS: usize = 64;
 pub const SEARCH_FRAMES: usize = 4000;
 /// Capture time (µs) after the first cyclic frame within which the search buffers frames.
 pub const SEARCH_US: u64 = 10_000_000;
+
+/// Why a provider in STOP from its first frame is no violation of PN-RT-DS-002.
+const STARTUP_STOP: &str = "start-up: a provider reports STOP (DataStatus.ProviderState = 0) until its application runs; an IO controller sends STOP from its first cyclic frame until its program runs after ApplicationReady (IEC 61158-6-10 APDU_Status DataStatus bit 4)";
+
+/// Why a bad IOPS of a provider in STOP is no violation of PN-IO-IOPS-001.
+const BAD_IN_STOP: &str = "a provider in STOP marks its data bad (IOPS = Bad: CPU in \"Stop\" state, bus description 3.9; IEC 61158-6-10 IOxS)";
 
 /// µs per cycle counter unit (IEC 61158-6-10: 31.25 µs).
 const COUNT_NS: u64 = 31_250;
@@ -95,6 +104,10 @@ pub struct PnOptions {
     pub module_ident: Option<u32>,
     /// Search the cyclic frames for PSD4xx process data when no Connect describes them.
     pub search: bool,
+    /// The input can be read a second time: a drive the search finds late is checked from
+    /// the capture's start in a second pass ([`PnChecker::replay_pdu`]) instead of from the
+    /// frames buffered when it was found.
+    pub rescan: bool,
 }
 
 impl Default for PnOptions {
@@ -105,6 +118,7 @@ impl Default for PnOptions {
             manual: None,
             module_ident: None,
             search: true,
+            rescan: false,
         }
     }
 }
@@ -138,6 +152,15 @@ struct Stream {
     valid_seen: bool,
     invalid: bool,
     stop: bool,
+    /// The provider has been in RUN: a STOP after it is a finding, before it start-up.
+    run_seen: bool,
+    /// The listed start-up STOP, to be ended when the provider goes to RUN.
+    stop_allowed: Option<usize>,
+    /// IOxS offsets whose bad value is listed as allowed (provider in STOP), to be ended.
+    iox_allowed: Vec<(usize, Option<usize>)>,
+    /// Listed violations of the open conditions (DS-001, DS-002, DS-003, DS-004, TS-001,
+    /// LEN-001), to be ended.
+    open: [Option<usize>; 6],
     problem: bool,
     reserved: bool,
     transfer: bool,
@@ -199,6 +222,18 @@ pub struct PnChecker<'s> {
     drives: Vec<Located<'s>>,
     search: Option<Vec<Buffered>>,
     search_start: Option<u64>,
+    /// Batches searched without finding anything.
+    batches: u64,
+    /// Cyclic frames searched without finding anything.
+    searched: u64,
+    /// After a fruitless batch: the last C_SDU of each stream; the next batch starts when
+    /// one changes (an idle drive starts to move or to talk).
+    watch: HashMap<StreamKey, Vec<u8>, BuildFx>,
+    /// Drives found in a later batch, to be checked from the capture's start in a second
+    /// pass over the input.
+    late: Vec<locate::Found>,
+    /// Where the first of the late drives was found.
+    late_at: Option<Where>,
     pending_records: HashMap<(Uuid, u16), PendingRecord>,
     cyclic_frames: u64,
     connects_without_psd: u64,
@@ -302,6 +337,11 @@ impl<'s> PnChecker<'s> {
             drives: Vec::new(),
             search: (options.search && options.manual.is_none()).then(Vec::new),
             search_start: None,
+            batches: 0,
+            searched: 0,
+            watch: HashMap::with_hasher(BuildFx),
+            late: Vec::new(),
+            late_at: None,
             pending_records: HashMap::new(),
             cyclic_frames: 0,
             connects_without_psd: 0,
@@ -550,6 +590,10 @@ impl<'s> PnChecker<'s> {
                         valid_seen: false,
                         invalid: false,
                         stop: false,
+                        run_seen: false,
+                        stop_allowed: None,
+                        iox_allowed: Vec::new(),
+                        open: [None; 6],
                         problem: false,
                         reserved: false,
                         transfer: false,
@@ -564,7 +608,7 @@ impl<'s> PnChecker<'s> {
         let mut found = Vec::new();
         let mut label = String::new();
         if let Some((_, s)) = self.streams.get_mut(idx) {
-            stream_frame(s, &at, data, apdu, &mut found);
+            stream_frame(s, &at, data, apdu, &mut found, &mut self.rec);
             if !found.is_empty() {
                 label = s.label.clone();
             }
@@ -575,8 +619,11 @@ impl<'s> PnChecker<'s> {
         // PSD4xx images in this frame.
         let olen = Output::buffer_len(&self.rules);
         let ilen = Input::buffer_len(&self.rules);
+        // Bus description 3.9: with IOPS bad (CPU in STOP) the drive keeps the last valid
+        // outputs, so such an output image is not one the drive acts on.
+        let valid = apdu.data_status.provider_run() && apdu.data_status.data_valid();
         for d in self.drives.iter_mut() {
-            if d.out.matches(&key) {
+            if d.out.matches(&key) && valid && output_good(&d.out, data) {
                 if let Some(w) = data.get(d.out.offset..d.out.offset + olen) {
                     d.drive.output(&mut self.rec, at, w);
                 }
@@ -587,13 +634,34 @@ impl<'s> PnChecker<'s> {
                 }
             }
         }
-        self.buffer_for_search(key, data, at);
+        self.buffer_for_search(key, data, at, valid);
     }
 
-    fn buffer_for_search(&mut self, key: StreamKey, data: &[u8], at: Where) {
+    fn buffer_for_search(&mut self, key: StreamKey, data: &[u8], at: Where, valid: bool) {
         let Some(buf) = self.search.as_mut() else {
             return;
         };
+        if buf.is_empty() && self.batches > 0 {
+            // Between batches: wait until a stream's data change.
+            let changed = match self.watch.get_mut(&key) {
+                Some(last) if last.as_slice() == data => false,
+                Some(last) => {
+                    last.clear();
+                    last.extend_from_slice(data);
+                    true
+                }
+                None => {
+                    if self.watch.len() < MAX_STREAMS {
+                        self.watch.insert(key, data.to_vec());
+                    }
+                    false
+                }
+            };
+            if !changed {
+                return;
+            }
+            self.search_start = None;
+        }
         if let Some(t) = at.time {
             self.search_start.get_or_insert(t);
         }
@@ -605,13 +673,17 @@ impl<'s> PnChecker<'s> {
             key,
             data: data.to_vec(),
             at,
+            valid,
         });
         if buf.len() >= SEARCH_FRAMES || elapsed >= SEARCH_US {
             self.run_search();
         }
     }
 
-    /// Runs the search on the buffered frames and replays them to the drives found.
+    /// Searches the buffered frames (a batch); the drives found are checked from the
+    /// capture's start: by replaying the buffer when it is the capture's first batch,
+    /// else in a second pass when the input allows it ([`PnOptions::rescan`]), else from
+    /// the batch on.
     fn run_search(&mut self) {
         let Some(buf) = self.search.take() else {
             return;
@@ -619,21 +691,46 @@ impl<'s> PnChecker<'s> {
         if !self.drives.is_empty() {
             return;
         }
-        if buf.is_empty() {
-            self.rec
-                .report()
-                .note("no PSD4xx found: no Connect with PSD4xx modules and no cyclic frames");
-            return;
-        }
-        let found = locate::search(&self.rules, &buf);
+        let found = if buf.is_empty() {
+            Vec::new()
+        } else {
+            locate::search(&self.rules, &buf)
+        };
         if found.is_empty() {
-            self.rec.report().note(format!(
-                "no PSD4xx found: no Connect with PSD4xx modules, and the search over the first {} cyclic frames found no window that behaves like PSD4xx process data (give --frame-id and --offset to check anyway)",
-                buf.len()
-            ));
+            self.searched += buf.len() as u64;
+            self.batches += 1;
+            // Keep searching later batches, watching for changes from the last frames on.
+            for b in buf.iter().rev() {
+                if self.watch.len() >= MAX_STREAMS {
+                    break;
+                }
+                self.watch.entry(b.key).or_insert_with(|| b.data.clone());
+            }
+            let mut buf = buf;
+            buf.clear();
+            self.search = Some(buf);
             return;
         }
-        for f in &found {
+        let first = self.batches == 0;
+        let at = buf.first().map(|b| b.at);
+        if !first && self.options.rescan {
+            self.late = found;
+            self.late_at = at;
+            return;
+        }
+        if !first {
+            if let Some(w) = at {
+                self.rec.report().note(format!(
+                    "PSD4xx found in the frames from {w} on; the input cannot be read twice, so the drive checks start there"
+                ));
+            }
+        }
+        self.add_found(&found);
+        self.replay(&buf);
+    }
+
+    fn add_found(&mut self, found: &[locate::Found]) {
+        for f in found {
             let details = BTreeMap::from([
                 (
                     "out_frame_id".to_owned(),
@@ -649,12 +746,16 @@ impl<'s> PnChecker<'s> {
             ]);
             self.add_drive(f.out, f.inp, None, "search", f.confidence, details);
         }
+    }
+
+    /// Feeds buffered frames to the drives.
+    fn replay(&mut self, buf: &[Buffered]) {
         let olen = Output::buffer_len(&self.rules);
         let ilen = Input::buffer_len(&self.rules);
-        for b in &buf {
+        for b in buf {
             let at = b.at;
             for d in self.drives.iter_mut() {
-                if d.out.matches(&b.key) {
+                if d.out.matches(&b.key) && b.valid && output_good(&d.out, &b.data) {
                     if let Some(w) = b.data.get(d.out.offset..d.out.offset + olen) {
                         d.drive.output(&mut self.rec, at, w);
                     }
@@ -663,6 +764,81 @@ impl<'s> PnChecker<'s> {
                     if let Some(w) = b.data.get(d.inp.offset..d.inp.offset + ilen) {
                         d.drive.input(&mut self.rec, at, w);
                     }
+                }
+            }
+        }
+    }
+
+    /// Whether drives were found late and wait for a second pass over the input
+    /// ([`PnChecker::replay_pdu`] for every record from the start, then
+    /// [`PnChecker::finish`]).
+    pub fn wants_second_pass(&self) -> bool {
+        !self.late.is_empty()
+    }
+
+    /// Starts the second pass: the drives found late are checked from here on.
+    pub fn begin_second_pass(&mut self) {
+        let late = std::mem::take(&mut self.late);
+        if let Some(w) = self.late_at {
+            self.rec.report().note(format!(
+                "PSD4xx found in the frames from {w} on; its checks ran from the capture's start in a second pass"
+            ));
+        }
+        self.add_found(&late);
+    }
+
+    /// One record of the second pass: only the drives' images and record reads and writes
+    /// are checked (the generic checks ran in the first pass).
+    pub fn replay_pdu(&mut self, record: u64, time: Option<u64>, pdu: &Result<Pdu<'_>, PduError>) {
+        if let Ok(Pdu::Rpc {
+            message: Some(Ok(m)),
+            link,
+            ..
+        }) = pdu
+        {
+            if matches!(
+                m.operation,
+                Operation::Read | Operation::Write | Operation::ReadImplicit
+            ) {
+                let o = Origin {
+                    record,
+                    time,
+                    src: link.src,
+                    dst: link.dst,
+                };
+                self.record(&o, m);
+            }
+            return;
+        }
+        let Ok(Pdu::Rt { frame, link, .. }) = pdu else {
+            return;
+        };
+        let Ok(c) = frame.cyclic() else {
+            return;
+        };
+        let key: StreamKey = (
+            c.frame_id.0,
+            link.src.unwrap_or([0; 6]),
+            link.dst.unwrap_or([0; 6]),
+        );
+        let at = Where {
+            event: 0,
+            frame: Some(record),
+            time,
+            ..Where::default()
+        };
+        let valid = c.apdu.data_status.provider_run() && c.apdu.data_status.data_valid();
+        let olen = Output::buffer_len(&self.rules);
+        let ilen = Input::buffer_len(&self.rules);
+        for d in self.drives.iter_mut() {
+            if d.out.matches(&key) && valid && output_good(&d.out, c.data) {
+                if let Some(w) = c.data.get(d.out.offset..d.out.offset + olen) {
+                    d.drive.output(&mut self.rec, at, w);
+                }
+            }
+            if d.inp.matches(&key) {
+                if let Some(w) = c.data.get(d.inp.offset..d.inp.offset + ilen) {
+                    d.drive.input(&mut self.rec, at, w);
                 }
             }
         }
@@ -754,11 +930,19 @@ impl<'s> PnChecker<'s> {
             (Some(a), Some(b)) => format!("{} → {}", mac(&a), mac(&b)),
             _ => "PNIO-CM".into(),
         };
+        let decode = match s.decode {
+            0x80 => " (PNIORW)",
+            0x81 => " (PNIO)",
+            _ => "",
+        };
         self.rec.violation(
             "PN-CM-002",
             &subject,
             at,
-            format!("{what} answered with PNIOStatus {s}"),
+            format!(
+                "{what} answered with PNIOStatus {s}: ErrorCode {:#04x}, ErrorDecode {:#04x}{decode}, ErrorCode1 {:#04x}, ErrorCode2 {:#04x}",
+                s.code, s.decode, s.code1, s.code2
+            ),
             Evidence::none().with("pnio_status", s.to_string()),
         );
     }
@@ -1062,9 +1246,36 @@ impl<'s> PnChecker<'s> {
         });
     }
 
+    /// Ends the first pass over the input: searches the frames still buffered. Then
+    /// [`PnChecker::wants_second_pass`] tells whether a second pass is due.
+    pub fn end_of_input(&mut self) {
+        self.run_search();
+    }
+
     /// Ends the capture; `counts` are the reader's frame counts, when known.
     pub fn finish(mut self, counts: Option<Counts>) -> Report {
         self.run_search();
+        if !self.late.is_empty() {
+            let late = std::mem::take(&mut self.late);
+            self.add_found(&late);
+            if let Some(w) = self.late_at {
+                self.rec.report().note(format!(
+                    "PSD4xx found in the frames from {w} on, but the input was not read a second time: its checks did not run"
+                ));
+            }
+        } else if self.drives.is_empty() && self.options.search && self.options.manual.is_none() {
+            let searched = self.searched;
+            let note = if searched == 0 {
+                "no PSD4xx found: no Connect with PSD4xx modules and no cyclic frames".to_owned()
+            } else {
+                format!(
+                    "no PSD4xx found: no Connect with PSD4xx modules, and the search over {searched} cyclic frames (the capture's first frames and every later stretch in which the data changed) found no window that behaves like PSD4xx process data (give --frame-id and --offset to check anyway)"
+                )
+            };
+            if self.connects_without_psd == 0 || searched > 0 {
+                self.rec.report().note(note);
+            }
+        }
         let mut streams: Vec<(StreamKey, Stream)> = std::mem::take(&mut self.streams);
         streams.sort_by_key(|(k, _)| *k);
         let drives = std::mem::take(&mut self.drives);
@@ -1110,8 +1321,46 @@ impl<'s> PnChecker<'s> {
         if r.drives.is_empty() && !r.notes.iter().any(|n| n.starts_with("no PSD4xx")) {
             r.note("no PSD4xx found in this capture; only the generic PROFINET checks ran");
         }
+        r.scope("PROFINET", None, None);
+        let why_not = r.drives.is_empty().then(|| "no drive found".to_owned());
+        r.scope("PSD4xx", Some("psd4xx"), why_not);
+        r.judge(Policy::default());
         self.rec.finish()
     }
+}
+
+/// A condition `k` of a stream (DataStatus, TransferStatus, length): a violation when it
+/// starts (`now` and not `was`), ended with its duration when it stops.
+#[allow(clippy::too_many_arguments)]
+fn condition(
+    rec: &mut Recorder,
+    label: &str,
+    open: &mut [Option<usize>; 6],
+    k: usize,
+    now: bool,
+    was: bool,
+    at: &Where,
+    what: &dyn Fn() -> (&'static str, String),
+    ev: &dyn Fn() -> Evidence,
+) {
+    let Some(slot) = open.get_mut(k) else {
+        return;
+    };
+    if now && !was {
+        let (id, message) = what();
+        *slot = rec.violation(id, label, *at, message, ev());
+    } else if !now && was {
+        if let Some(i) = slot.take() {
+            rec.violation_ended(i, *at);
+        }
+    }
+}
+
+/// Whether the provider status (IOPS) of the output module `b` in `data` is good, or unknown.
+fn output_good(b: &Binding, data: &[u8]) -> bool {
+    b.iops
+        .and_then(|o| data.get(o))
+        .is_none_or(|iops| iops & 0x80 != 0)
 }
 
 /// The generic checks of one cyclic frame of stream `s`.
@@ -1121,6 +1370,7 @@ fn stream_frame(
     data: &[u8],
     apdu: ApduStatus,
     found: &mut Vec<(&'static str, String, Evidence)>,
+    rec: &mut Recorder,
 ) {
     s.frames += 1;
     let counter = apdu.cycle_counter;
@@ -1164,12 +1414,16 @@ fn stream_frame(
                     ));
                 } else {
                     let steps = u64::from(delta / inc);
-                    if steps > 1 {
+                    // Frames missing: the cycles the counter skipped, unless the capture
+                    // time shows fewer passed (a counter glitch loses no frame).
+                    let nominal = u64::from(inc) * COUNT_NS / 1000;
+                    let by_time = dt.map(|d| (d + nominal / 2) / nominal.max(1));
+                    let cycles = by_time.map_or(steps, |t| steps.min(t.max(1)));
+                    if cycles > 1 {
                         s.gaps += 1;
-                        s.missing += steps - 1;
+                        s.missing += cycles - 1;
                     }
                     if let Some(d) = dt {
-                        let nominal = u64::from(inc) * COUNT_NS / 1000;
                         s.jitter.add((d as f64 - (steps * nominal) as f64).abs());
                         let expected = u64::from(delta) * COUNT_NS / 1000;
                         if d > expected * 2 + 4000 || d + 4000 < expected / 2 {
@@ -1208,68 +1462,82 @@ fn stream_frame(
         }
     }
     s.last = time.map(|t| (counter, t, *at)).or(Some((counter, 0, *at)));
-    // DataStatus and TransferStatus: report when a condition starts.
+    // DataStatus and TransferStatus: report when a condition starts, end it when it stops.
     let valid = ds.data_valid();
     if valid {
         s.valid_seen = true;
     }
     let invalid = s.valid_seen && !valid;
-    if invalid && !s.invalid {
-        found.push((
-            "PN-RT-DS-001",
-            "DataValid cleared after valid data".into(),
-            ev(),
-        ));
-    }
-    s.invalid = invalid;
+    let label = s.label.clone();
+    let mut cond = |k: usize, now: bool, was: bool, what: &dyn Fn() -> (&'static str, String)| {
+        condition(rec, &label, &mut s.open, k, now, was, at, what, &ev);
+    };
+    cond(0, invalid, s.invalid, &|| {
+        ("PN-RT-DS-001", "DataValid cleared after valid data".into())
+    });
     let stop = !ds.provider_run();
-    if stop && !s.stop {
-        found.push(("PN-RT-DS-002", "provider in STOP".into(), ev()));
-    }
-    s.stop = stop;
+    cond(1, stop && s.run_seen, s.stop && s.run_seen, &|| {
+        ("PN-RT-DS-002", "provider went from RUN to STOP".into())
+    });
     let problem = !ds.station_ok();
-    if problem && !s.problem {
-        found.push((
+    cond(2, problem, s.problem, &|| {
+        (
             "PN-RT-DS-003",
             "StationProblemIndicator signals a problem".into(),
-            ev(),
-        ));
-    }
-    s.problem = problem;
+        )
+    });
     let reserved = ds.reserved() != 0;
-    if reserved && !s.reserved {
-        found.push((
+    cond(3, reserved, s.reserved, &|| {
+        (
             "PN-RT-DS-004",
             format!("reserved DataStatus bits {:#04x} set", ds.reserved()),
-            ev(),
-        ));
-    }
-    s.reserved = reserved;
+        )
+    });
     let transfer = apdu.transfer_status != 0;
-    if transfer && !s.transfer {
-        found.push((
+    cond(4, transfer, s.transfer, &|| {
+        (
             "PN-RT-TS-001",
             format!("TransferStatus {:#04x}", apdu.transfer_status),
-            ev(),
-        ));
+        )
+    });
+    let short = s
+        .info
+        .as_ref()
+        .is_some_and(|info| data.len() < info.data_length);
+    let announced = s.info.as_ref().map_or(0, |i| i.data_length);
+    cond(5, short, s.short, &|| {
+        (
+            "PN-RT-LEN-001",
+            format!(
+                "{} byte(s) of data where the Connect announced a C_SDU of {announced}",
+                data.len()
+            ),
+        )
+    });
+    if stop && !s.stop && !s.run_seen {
+        s.stop_allowed = rec.allowed(
+            "PN-RT-DS-002",
+            &s.label,
+            *at,
+            "provider in STOP from its first frame (start-up)",
+            STARTUP_STOP,
+        );
     }
+    if !stop {
+        if let Some(i) = s.stop_allowed.take() {
+            rec.ended(i, *at);
+        }
+        s.run_seen = true;
+    }
+    s.invalid = invalid;
+    s.stop = stop;
+    s.problem = problem;
+    s.reserved = reserved;
     s.transfer = transfer;
+    s.short = short;
     let Some(info) = s.info.as_ref() else {
         return;
     };
-    let short = data.len() < info.data_length;
-    if short && !s.short {
-        found.push((
-            "PN-RT-LEN-001",
-            format!(
-                "{} byte(s) of data where the Connect announced a C_SDU of {}",
-                data.len(),
-                info.data_length
-            ),
-            ev(),
-        ));
-    }
-    s.short = short;
     // IOxS: bit 7 DataState good (0x80).
     let positions: Vec<(String, usize, &'static str)> = info
         .iops
@@ -1288,11 +1556,29 @@ fn stream_frame(
         let good = b & 0x80 != 0;
         let was = s.iox.insert(offset, good);
         if !good && was.is_some_and(|g| g) && s.valid_seen {
-            found.push((
-                id,
-                format!("{label} = {b:#04x} (bad)"),
-                ev().with("offset", offset).with("iox", format!("{b:#04x}")),
-            ));
+            if stop {
+                let listed = rec.allowed(
+                    id,
+                    &s.label,
+                    *at,
+                    format!("{label} = {b:#04x} (bad) while the provider is in STOP"),
+                    BAD_IN_STOP,
+                );
+                s.iox_allowed.push((offset, listed));
+            } else {
+                found.push((
+                    id,
+                    format!("{label} = {b:#04x} (bad)"),
+                    ev().with("offset", offset).with("iox", format!("{b:#04x}")),
+                ));
+            }
+        }
+        if good && was.is_some_and(|g| !g) {
+            if let Some(k) = s.iox_allowed.iter().position(|(o, _)| *o == offset) {
+                if let (_, Some(i)) = s.iox_allowed.swap_remove(k) {
+                    rec.ended(i, *at);
+                }
+            }
         }
     }
 }

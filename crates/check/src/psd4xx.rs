@@ -63,6 +63,7 @@ pub const CHECKED: &[&str] = &[
     "PSD-STS-5-SET-1",
     "PSD-STS-6-SET-1",
     "PSD-STS-6-RESET-1",
+    "PSD-STS-12-SET-1",
     "PSD-STS-14-RESET-1",
     "PSD-STS-15-RESET-1",
     "PSD-PAR-44-001",
@@ -101,6 +102,7 @@ mod bit {
     pub const ABORTED: u16 = 1 << 5;
     pub const RUNNING: u16 = 1 << 6;
     pub const OVERLOAD: u16 = 1 << 10;
+    pub const BAD_TARGET: u16 = 1 << 12;
     pub const UPPER_LIMIT: u16 = 1 << 14;
     pub const LOWER_LIMIT: u16 = 1 << 15;
     pub const MANUAL_UP: u16 = 1 << 0;
@@ -112,6 +114,9 @@ mod bit {
 
 /// Parameter numbers the relations use (bus description 3.3).
 mod par {
+    pub const ACTUAL: u16 = 3;
+    pub const NUMERATOR: u16 = 38;
+    pub const DENOMINATOR: u16 = 39;
     pub const UPPER_LIMIT: u16 = 42;
     pub const LOWER_LIMIT: u16 = 43;
     pub const WINDOW: u16 = 44;
@@ -180,6 +185,11 @@ pub struct PsdDrive<'s> {
     upper: Streak,
     lower: Streak,
     window_state: bool,
+    /// A transferred target beyond the limits, waiting for status bit 12: (image count then,
+    /// where, target, the limit it exceeds).
+    bad_target: Option<(u64, Where, i32, i64)>,
+    /// Checks already reported as undecidable on this drive (each once).
+    undecided: Vec<&'static str>,
     prio_state: bool,
     abort_pending: Option<(u64, Where)>,
     spm_state: bool,
@@ -249,6 +259,8 @@ impl<'s> PsdDrive<'s> {
             upper: Streak::default(),
             lower: Streak::default(),
             window_state: false,
+            bad_target: None,
+            undecided: Vec::new(),
             prio_state: false,
             abort_pending: None,
             spm_state: false,
@@ -310,8 +322,11 @@ impl<'s> PsdDrive<'s> {
         if prev_control != Some(out.control) {
             self.control_changed(rec, at, bytes, prev_control, out.control);
         }
-        if out.control & bit::TRANSFER != 0 && self.target.is_none_or(|(t, _)| t != out.target) {
+        let transfer = out.control & bit::TRANSFER != 0;
+        let was = prev.filter(|p| p.control & bit::TRANSFER != 0);
+        if transfer && was.is_none_or(|p| p.target != out.target) {
             self.target = Some((out.target, self.inputs));
+            self.transferred(rec, at, out.target);
         }
         if self.last_pkw_out != Some(out.pkw) {
             self.pkw_command(rec, at, bytes, out.pkw);
@@ -493,29 +508,85 @@ impl<'s> PsdDrive<'s> {
             }
         }
         self.window_check(rec, at, &inp, bytes);
+        self.bad_target_check(rec, at, &inp, bytes);
         self.limit_check(rec, at, &inp, bytes);
         self.pkw_answer(rec, at, bytes, inp.pkw);
         self.inp = Some(inp);
     }
 
-    /// PSD-PAR-44-001: bit 0 only inside the positioning window around the target in force.
+    /// Reports once per drive that check `id` cannot decide, and why.
+    fn undecided(&mut self, rec: &mut Recorder, id: &'static str, at: Where, why: &str) {
+        if self.undecided.contains(&id) {
+            return;
+        }
+        self.undecided.push(id);
+        rec.inconclusive(id, &self.label, at, "not checked on this drive", why);
+    }
+
+    /// The positioning window in force: par 44 as the capture shows it, else the largest the
+    /// manual allows (3.3 par 44: 1 to 100 at delivery scaling, scaled with the resolution,
+    /// PSD-PAR-44-003), with how it was decided.
+    fn window(&self) -> Option<(i64, &'static str)> {
+        if let Some(k) = self.known.get(&par::WINDOW) {
+            return Some((k.value, "par 44"));
+        }
+        let p = self.rules.parameter(u32::from(par::WINDOW))?;
+        let max = self.family.resolve(p, self.model).range?.max()?;
+        let scale = match (
+            self.known.get(&par::NUMERATOR).map(|k| k.value),
+            self.known.get(&par::DENOMINATOR).map(|k| k.value),
+        ) {
+            (Some(n), Some(d)) if n > 0 && d > 0 => (n.max(d) + n.min(d) - 1) / n.min(d),
+            (None, None) => 1,
+            _ => return None,
+        };
+        Some((
+            max.saturating_mul(scale),
+            "par 44 not seen: the largest window (3.3 par 44)",
+        ))
+    }
+
+    /// PSD-PAR-44-001: bit 0 only inside the positioning window around the target in force,
+    /// at standstill and during a run.
     fn window_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
-        let (Some((target, since)), Some(window)) =
-            (self.target, self.known.get(&par::WINDOW).map(|k| k.value))
-        else {
+        let reached = inp.status & bit::TARGET_REACHED != 0;
+        let Some((target, since)) = self.target else {
+            if reached {
+                self.undecided(
+                    rec,
+                    "PSD-PAR-44-001",
+                    at,
+                    "status bit 0 is set but no target was transferred in the capture so far",
+                );
+            }
+            return;
+        };
+        let Some((window, basis)) = self.window() else {
+            if reached {
+                self.undecided(
+                    rec,
+                    "PSD-PAR-44-001",
+                    at,
+                    "par 44 not seen and only one of the scaling parameters (par 38, 39) known",
+                );
+            }
             return;
         };
         let settled = self.inputs.saturating_sub(since) >= self.options.lag_cycles;
-        let reached = inp.status & bit::TARGET_REACHED != 0 && inp.status & bit::RUNNING == 0;
         let off = (i64::from(inp.actual) - i64::from(target)).abs();
         let bad = settled && reached && off > window;
         if bad && !self.window_state {
+            let running = if inp.status & bit::RUNNING != 0 {
+                " during a run"
+            } else {
+                ""
+            };
             self.violation(
                 rec,
                 "PSD-PAR-44-001",
                 at,
                 format!(
-                    "target reached (status bit 0) at {} while the target is {target}: {off} apart, window (par 44) {window}",
+                    "target reached (status bit 0){running} at {} while the target is {target}: {off} apart, window {window} ({basis})",
                     inp.actual
                 ),
                 Evidence::bytes(bytes)
@@ -525,6 +596,61 @@ impl<'s> PsdDrive<'s> {
             );
         }
         self.window_state = bad;
+    }
+
+    /// A target transferred: beyond the limits in force (par 42/43), status bit 12 is due
+    /// (3.6 bit 12, PSD-STS-12-SET-1).
+    fn transferred(&mut self, rec: &mut Recorder, at: Where, target: i32) {
+        self.bad_target = None;
+        let (Some(upper), Some(lower)) = (
+            self.known.get(&par::UPPER_LIMIT).map(|k| k.value),
+            self.known.get(&par::LOWER_LIMIT).map(|k| k.value),
+        ) else {
+            self.undecided(
+                rec,
+                "PSD-STS-12-SET-1",
+                at,
+                "the limits (par 42, 43) were not seen before the first target transfer",
+            );
+            return;
+        };
+        let t = i64::from(target);
+        if t > upper {
+            self.bad_target = Some((self.inputs, at, target, upper));
+        } else if t < lower {
+            self.bad_target = Some((self.inputs, at, target, lower));
+        }
+    }
+
+    /// PSD-STS-12-SET-1: after a target beyond the limits, bit 12 within the lag.
+    fn bad_target_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
+        let Some((since, w, target, limit)) = self.bad_target else {
+            return;
+        };
+        if inp.status & bit::BAD_TARGET != 0 {
+            self.bad_target = None;
+            return;
+        }
+        if self.inputs.saturating_sub(since) >= self.options.lag_cycles {
+            self.bad_target = None;
+            let running = if inp.status & bit::RUNNING != 0 {
+                ", and the drive is running"
+            } else {
+                ""
+            };
+            self.violation(
+                rec,
+                "PSD-STS-12-SET-1",
+                at,
+                format!(
+                    "target {target} transferred at {w} lies beyond the limit {limit}; status bit 12 (incorrect target value) is not set{running}"
+                ),
+                Evidence::bytes(bytes)
+                    .with("target", target)
+                    .with("limit", limit)
+                    .with("status", format!("{:#06x}", inp.status)),
+            );
+        }
     }
 
     /// PSD-STS-14-RESET-1 and PSD-STS-15-RESET-1: a limit bit only while the position is at or
@@ -796,7 +922,7 @@ impl<'s> PsdDrive<'s> {
                         "PSD-PAR-RANGE-001",
                         at,
                         format!(
-                            "par {pnu} ({}) reads {value}, outside its range {r:?}",
+                            "par {pnu} ({}) reads {value}, outside its range {r}",
                             p.name
                         ),
                         ev.clone().with("value", value),
@@ -875,9 +1001,46 @@ impl<'s> PsdDrive<'s> {
                 return;
             }
         }
+        self.rereferenced(pnu, value);
         let live = self.rules.parameter(u32::from(pnu)).is_none_or(|p| p.live);
         if !live {
             self.known.insert(pnu, Known { value, at });
+        }
+    }
+
+    /// Values the drive recalculates after an accepted write of `pnu` (4.7 notes 3–6 and
+    /// "Reference value"): writing the actual value (par 3) shifts the referencing value
+    /// (par 40), and with it the target, the actual value and the limits, by the difference
+    /// to the current position; the direction (37), scaling (38, 39), referencing value
+    /// (40) and mapping end (41) change them by amounts the capture does not show, so the
+    /// target and limits are forgotten until transferred or read again.
+    fn rereferenced(&mut self, pnu: u16, value: i64) {
+        match pnu {
+            par::ACTUAL => {
+                let Some(actual) = self.inp.map(|i| i64::from(i.actual)) else {
+                    self.target = None;
+                    return;
+                };
+                let delta = value.saturating_sub(actual);
+                self.target = self.target.map(|(t, since)| {
+                    let shifted = i64::from(t).saturating_add(delta);
+                    (i32::try_from(shifted).unwrap_or(t), since)
+                });
+                for p in [par::UPPER_LIMIT, par::LOWER_LIMIT] {
+                    if let Some(k) = self.known.get_mut(&p) {
+                        k.value = k.value.saturating_add(delta);
+                    }
+                }
+                self.known.remove(&40);
+            }
+            37..=41 => {
+                self.target = None;
+                self.bad_target = None;
+                for p in [par::UPPER_LIMIT, par::LOWER_LIMIT, par::WINDOW, 40] {
+                    self.known.remove(&p);
+                }
+            }
+            _ => {}
         }
     }
 

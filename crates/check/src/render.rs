@@ -3,7 +3,7 @@
 //! with a timeline plot (inline SVG) per positioning drive. Output size is bounded by the
 //! reports (violation listing cap, bounded timelines). Nothing here panics.
 
-use crate::report::{format_time, Report, SCHEMA};
+use crate::report::{format_time, Observation, Report, Verdict, SCHEMA};
 use crate::timeline::Timeline;
 use drivespec_report::escape as xml;
 use drivespec_report::junit::{self as xml_junit, Case, Form, Outcome, Suite};
@@ -18,6 +18,12 @@ pub struct Document<'a> {
     pub schema: &'static str,
     /// Violations counted over all files.
     pub violation_count: u64,
+    /// `must` violations counted over all files.
+    pub must_count: u64,
+    /// Warnings (violations of other levels) counted over all files.
+    pub warning_count: u64,
+    /// Files whose verdict is `fail`.
+    pub failed: u64,
     /// Files whose reading stopped early.
     pub unreadable: u64,
     /// One report per file, in the order given.
@@ -29,6 +35,15 @@ pub fn json(reports: &[Report]) -> String {
     let doc = Document {
         schema: SCHEMA,
         violation_count: reports.iter().map(|r| r.violation_count).sum(),
+        must_count: reports.iter().map(Report::must_count).sum(),
+        warning_count: reports
+            .iter()
+            .map(|r| r.violation_count.saturating_sub(r.must_count()))
+            .sum(),
+        failed: reports
+            .iter()
+            .filter(|r| r.verdict == Verdict::Fail)
+            .count() as u64,
         unreadable: reports.iter().filter(|r| r.error.is_some()).count() as u64,
         reports,
     };
@@ -96,10 +111,14 @@ pub fn text(reports: &[Report]) -> String {
             }
         }
         let checked = r.requirements.len();
+        let must = r.must_count();
         let _ = writeln!(
             o,
-            "  requirements checked: {checked}; violations: {}",
-            r.violation_count
+            "  requirements checked: {checked}; violations: {} ({must} must, {} warning(s)); allowed states: {}; inconclusive: {}",
+            r.violation_count,
+            r.violation_count.saturating_sub(must),
+            r.allowed_count,
+            r.inconclusive_count
         );
         for (id, t) in r.requirements.iter().filter(|(_, t)| t.violations > 0) {
             let _ = writeln!(
@@ -117,9 +136,14 @@ pub fn text(reports: &[Report]) -> String {
             };
             let _ = writeln!(o, "  violations{capped}:");
             for v in &r.violations {
+                let until = match (&v.end, v.duration_us) {
+                    (Some(e), Some(d)) => format!(" (until {e}: {})", duration(d)),
+                    (Some(e), None) => format!(" (until {e})"),
+                    (None, _) => String::new(),
+                };
                 let _ = writeln!(
                     o,
-                    "    {} {} — {}: {}",
+                    "    {} {} — {}: {}{until}",
                     v.at, v.requirement, v.subject, v.message
                 );
                 if let Some(b) = &v.evidence.bytes {
@@ -140,6 +164,14 @@ pub fn text(reports: &[Report]) -> String {
                 }
             }
         }
+        observations(&mut o, "allowed states", &r.allowed, r.allowed_count, true);
+        observations(
+            &mut o,
+            "inconclusive",
+            &r.inconclusive,
+            r.inconclusive_count,
+            false,
+        );
         for n in &r.notes {
             let _ = writeln!(o, "  note: {n}");
         }
@@ -149,16 +181,70 @@ pub fn text(reports: &[Report]) -> String {
         if let Some(e) = &r.error {
             let _ = writeln!(o, "  error: reading stopped: {}", e.message);
         }
-        let verdict = if r.error.is_some() {
-            "UNREADABLE (checked up to the error)"
-        } else if r.violation_count > 0 {
-            "FAIL"
-        } else {
-            "PASS"
-        };
-        let _ = writeln!(o, "  result: {verdict}");
+        let mut line = format!("  result: {}", r.verdict.as_str());
+        let scopes = r.scope_line();
+        if !scopes.is_empty() {
+            let _ = write!(line, " — {scopes}");
+        }
+        let missing: Vec<&str> = r
+            .policy
+            .require
+            .iter()
+            .filter(|f| {
+                !r.scopes
+                    .iter()
+                    .any(|s| s.ran && s.family.as_deref() == Some(f.as_str()))
+            })
+            .map(String::as_str)
+            .collect();
+        if !missing.is_empty() {
+            let _ = write!(line, " (required: {})", missing.join(", "));
+        }
+        if r.policy.strict && r.must_count() < r.violation_count {
+            line.push_str(" (--strict: warnings fail)");
+        }
+        let _ = writeln!(o, "{line}");
     }
     o
+}
+
+/// Lists allowed states (`spans`: with start, end and duration) or inconclusive checks
+/// (where), what and why.
+fn observations(o: &mut String, title: &str, list: &[Observation], count: u64, spans: bool) {
+    if count == 0 {
+        return;
+    }
+    let more = if (list.len() as u64) < count {
+        format!(" (first {} of {count})", list.len())
+    } else {
+        String::new()
+    };
+    let _ = writeln!(o, "  {title}{more}:");
+    for x in list {
+        let span = match (&x.end, x.duration_us, spans) {
+            (_, _, false) => x.start.to_string(),
+            (Some(e), Some(d), true) => format!("{} to {e} ({})", x.start, duration(d)),
+            (Some(e), None, true) => format!("{} to {e}", x.start),
+            (None, _, true) => format!("{} to the end of the capture", x.start),
+        };
+        let _ = writeln!(
+            o,
+            "    {span} {} — {}: {}",
+            x.requirement, x.subject, x.message
+        );
+        let _ = writeln!(o, "        because: {}", x.reason);
+    }
+}
+
+/// A duration for people: µs, ms or s.
+pub fn duration(us: u64) -> String {
+    if us < 1000 {
+        format!("{us} µs")
+    } else if us < 10_000_000 {
+        format!("{:.1} ms", us as f64 / 1000.0)
+    } else {
+        format!("{:.3} s", us as f64 / 1_000_000.0)
+    }
 }
 
 /// JUnit XML: one test suite per file, one test case per requirement checked (failed when
@@ -171,13 +257,19 @@ pub fn junit(reports: &[Report]) -> String {
                 .requirements
                 .iter()
                 .map(|(id, t)| {
+                    let mut text = String::new();
+                    for v in r.violations.iter().filter(|v| &v.requirement == id) {
+                        let _ = writeln!(text, "{}: {}: {}", v.at, v.subject, v.message);
+                    }
+                    let fails = t.level == "must" || r.policy.strict;
                     let outcome = if t.violations == 0 {
                         Outcome::Passed
+                    } else if !fails {
+                        Outcome::PassedWithOutput(format!(
+                            "{} warning(s) [{}]: {}\n{text}",
+                            t.violations, t.level, t.text
+                        ))
                     } else {
-                        let mut text = String::new();
-                        for v in r.violations.iter().filter(|v| &v.requirement == id) {
-                            let _ = writeln!(text, "{}: {}: {}", v.at, v.subject, v.message);
-                        }
                         Outcome::Failed {
                             message: format!("{} violation(s): {}", t.violations, t.text),
                             kind: t.level.clone(),
@@ -204,9 +296,41 @@ pub fn junit(reports: &[Report]) -> String {
                     },
                 });
             }
+            for sc in &r.scopes {
+                let required = sc
+                    .family
+                    .as_ref()
+                    .is_some_and(|f| r.policy.require.contains(f));
+                let outcome = match (&sc.why_not, required) {
+                    (None, _) => Outcome::Passed,
+                    (Some(why), false) => Outcome::Skipped(why.clone()),
+                    (Some(why), true) => Outcome::Failed {
+                        message: format!("required checks did not run: {why}"),
+                        kind: "required".to_owned(),
+                        text: None,
+                    },
+                };
+                cases.push(Case {
+                    name: format!("{} checks ran", sc.name),
+                    classname: "drivespec.check.scope".to_owned(),
+                    time_ms: 0.0,
+                    outcome,
+                });
+            }
+            let must = r.must_count();
+            let properties = vec![
+                ("verdict".to_owned(), r.verdict.as_str().to_owned()),
+                ("must_violations".to_owned(), must.to_string()),
+                (
+                    "warnings".to_owned(),
+                    r.violation_count.saturating_sub(must).to_string(),
+                ),
+                ("allowed_states".to_owned(), r.allowed_count.to_string()),
+                ("inconclusive".to_owned(), r.inconclusive_count.to_string()),
+            ];
             Suite {
                 name: r.file.as_deref().unwrap_or("stream").to_owned(),
-                properties: Vec::new(),
+                properties,
                 cases,
             }
         })
@@ -356,18 +480,14 @@ fn svg(t: &Timeline) -> String {
 pub fn html(reports: &[Report]) -> String {
     let mut o = String::from("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>drivespec check</title>\n<style>body{font-family:sans-serif;margin:1em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;text-align:left;vertical-align:top}.fail{color:#b00}.pass{color:#070}code{font-size:90%}</style></head><body>\n<h1>drivespec check</h1>\n");
     for r in reports {
-        let verdict = if r.error.is_some() {
-            "<span class=\"fail\">unreadable</span>"
-        } else if r.violation_count > 0 {
-            "<span class=\"fail\">fail</span>"
-        } else {
-            "<span class=\"pass\">pass</span>"
-        };
+        let class = if r.passed() { "pass" } else { "fail" };
         let _ = writeln!(
             o,
-            "<h2>{} ({}) — {verdict}</h2>",
+            "<h2>{} ({}) — <span class=\"{class}\">{}</span></h2><p>{}</p>",
             xml(r.file.as_deref().unwrap_or("stream")),
-            xml(&r.family)
+            xml(&r.family),
+            xml(r.verdict.as_str()),
+            xml(&r.scope_line())
         );
         o.push_str("<ul>");
         for d in &r.detection {

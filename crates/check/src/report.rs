@@ -151,6 +151,12 @@ pub struct Violation {
     pub message: String,
     /// What shows it.
     pub evidence: Evidence,
+    /// Where a condition ended, when it ended before the capture did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end: Option<Where>,
+    /// The condition's duration in µs, when both ends have a time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duration_us: Option<u64>,
 }
 
 /// How often a requirement was checked and violated.
@@ -224,7 +230,8 @@ pub struct StreamStats {
     /// |interval − nominal| in µs.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub jitter_us: Option<Stats>,
-    /// Frames missing by the cycle counter (sum over gaps).
+    /// Frames missing: cycles the counter skipped, at most as many as the capture time shows
+    /// passed (sum over gaps).
     pub missing: u64,
     /// Gaps (places where at least one frame is missing).
     pub gaps: u64,
@@ -291,9 +298,119 @@ pub struct Report {
     /// Reading stopped early: why and where.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<InputFault>,
+    /// Violations counted per level (`must`, `should`, `informative`).
+    pub levels: BTreeMap<String, u64>,
+    /// States the standards allow that a stricter reading would flag, with start and end.
+    pub allowed: Vec<Observation>,
+    /// States allowed, counted (all of them, however many are listed).
+    pub allowed_count: u64,
+    /// Checks that could not decide, with why.
+    pub inconclusive: Vec<Observation>,
+    /// Inconclusive checks, counted.
+    pub inconclusive_count: u64,
+    /// What was and was not checked: one entry per group of checks.
+    pub scopes: Vec<Scope>,
+    /// How the verdict is reached (`--strict`, `--require`).
+    pub policy: Policy,
+    /// The verdict under `policy`: `pass`, `warn`, `fail` or `unreadable`.
+    pub verdict: Verdict,
     /// Position, speed and bits over time per positioning drive (HTML report only).
     #[serde(skip)]
     pub timelines: Vec<Timeline>,
+}
+
+/// Most allowed-state and inconclusive observations listed per report (all are counted).
+pub const MAX_OBSERVATIONS: usize = 200;
+
+/// A state that is not a violation: allowed by the standard or the manual, or a check that
+/// could not decide. Conditions have a start, an end (when they ended in the capture) and a
+/// duration.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Observation {
+    /// The requirement the state concerns.
+    pub requirement: String,
+    /// What it concerns (a stream, a drive).
+    pub subject: String,
+    /// Where it began.
+    pub start: Where,
+    /// Where it ended, when it ended before the capture did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end: Option<Where>,
+    /// Its duration in µs, when both ends have a time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duration_us: Option<u64>,
+    /// What was seen, one line.
+    pub message: String,
+    /// Why it is allowed, or why the check cannot decide (with the manual section).
+    pub reason: String,
+}
+
+/// One group of checks (generic PROFINET, PSD4xx, HPD, PSx3xx) and whether it ran.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Scope {
+    /// `PROFINET`, `PSD4xx`, `HPD`, `PSx3xx`.
+    pub name: String,
+    /// The family id it stands for (`psd4xx`, `hpd`, `psx3xx`), if one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub family: Option<String>,
+    /// Whether its checks ran.
+    pub ran: bool,
+    /// Why they did not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why_not: Option<String>,
+    /// `must` violations of its requirements.
+    pub must: u64,
+    /// Other violations (`should`, `informative`): warnings.
+    pub warnings: u64,
+}
+
+/// How the verdict is reached.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Policy {
+    /// Warnings fail too (`--strict`).
+    pub strict: bool,
+    /// Families whose checks must have run (`--require`), as family ids.
+    pub require: Vec<String>,
+}
+
+/// The verdict of one report.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// No violation; every required check ran.
+    #[default]
+    Pass,
+    /// Only warnings (`should` findings), and not `--strict`.
+    Warn,
+    /// A `must` violation, a warning under `--strict`, or a required check that did not run.
+    Fail,
+    /// Reading stopped early.
+    Unreadable,
+}
+
+impl Verdict {
+    /// The word printed on the result line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Pass => "PASS",
+            Verdict::Warn => "PASS with warnings",
+            Verdict::Fail => "FAIL",
+            Verdict::Unreadable => "UNREADABLE (checked up to the error)",
+        }
+    }
+}
+
+/// The scope a requirement belongs to, by its ID prefix.
+fn scope_of(id: &str) -> &'static str {
+    if id.starts_with("PN-") {
+        "PROFINET"
+    } else if id.starts_with("PSD-") {
+        "PSD4xx"
+    } else if id.starts_with("HPD-") {
+        "HPD"
+    } else {
+        "PSx3xx"
+    }
 }
 
 impl Report {
@@ -315,8 +432,105 @@ impl Report {
             notes: Vec::new(),
             notes_dropped: 0,
             error: None,
+            levels: BTreeMap::new(),
+            allowed: Vec::new(),
+            allowed_count: 0,
+            inconclusive: Vec::new(),
+            inconclusive_count: 0,
+            scopes: Vec::new(),
+            policy: Policy::default(),
+            verdict: Verdict::Pass,
             timelines: Vec::new(),
         }
+    }
+
+    /// Declares a group of checks: `ran` or not and why (its counts come from the tallies
+    /// in [`Report::judge`]).
+    pub fn scope(&mut self, name: &str, family: Option<&str>, why_not: Option<String>) {
+        self.scopes.retain(|s| s.name != name);
+        self.scopes.push(Scope {
+            name: name.to_owned(),
+            family: family.map(str::to_owned),
+            ran: why_not.is_none(),
+            why_not,
+            must: 0,
+            warnings: 0,
+        });
+    }
+
+    /// Counts the violations per scope and level and reaches the verdict under `policy`:
+    /// `must` violations fail, other levels warn (fail under `--strict`), a required family
+    /// whose checks did not run fails, a read error is `unreadable`.
+    pub fn judge(&mut self, policy: Policy) {
+        self.levels.clear();
+        for s in &mut self.scopes {
+            s.must = 0;
+            s.warnings = 0;
+        }
+        for (id, t) in &self.requirements {
+            if t.violations == 0 {
+                continue;
+            }
+            *self.levels.entry(t.level.clone()).or_insert(0) += t.violations;
+            let name = scope_of(id);
+            if let Some(s) = self.scopes.iter_mut().find(|s| s.name == name) {
+                if t.level == "must" {
+                    s.must += t.violations;
+                } else {
+                    s.warnings += t.violations;
+                }
+            }
+        }
+        let must = self.levels.get("must").copied().unwrap_or(0);
+        let warnings = self.violation_count.saturating_sub(must);
+        let missing = policy.require.iter().any(|f| {
+            !self
+                .scopes
+                .iter()
+                .any(|s| s.ran && s.family.as_deref() == Some(f.as_str()))
+        });
+        self.verdict = if self.error.is_some() {
+            Verdict::Unreadable
+        } else if must > 0 || missing || (policy.strict && warnings > 0) {
+            Verdict::Fail
+        } else if warnings > 0 {
+            Verdict::Warn
+        } else {
+            Verdict::Pass
+        };
+        self.policy = policy;
+    }
+
+    /// Whether the verdict lets the run pass (`pass` or `warn`).
+    pub fn passed(&self) -> bool {
+        matches!(self.verdict, Verdict::Pass | Verdict::Warn)
+    }
+
+    /// `must` violations counted.
+    pub fn must_count(&self) -> u64 {
+        self.levels.get("must").copied().unwrap_or(0)
+    }
+
+    /// The result line's list of what was and was not checked: `PROFINET: pass; PSD4xx: no
+    /// drive found`.
+    pub fn scope_line(&self) -> String {
+        let parts: Vec<String> = self
+            .scopes
+            .iter()
+            .map(|s| {
+                let state = if !s.ran {
+                    s.why_not.clone().unwrap_or_else(|| "not checked".into())
+                } else if s.must > 0 {
+                    format!("fail ({} must violation(s))", s.must)
+                } else if s.warnings > 0 {
+                    format!("pass with {} warning(s)", s.warnings)
+                } else {
+                    "pass".into()
+                };
+                format!("{}: {state}", s.name)
+            })
+            .collect();
+        parts.join("; ")
     }
 
     /// Whether nothing is wrong: no violation and no read error.
@@ -439,6 +653,30 @@ pub struct Recorder {
     listed: HashMap<String, u64>,
 }
 
+/// Lists an observation when fewer than [`MAX_OBSERVATIONS`] are; gives its index.
+fn observe(
+    list: &mut Vec<Observation>,
+    id: &str,
+    subject: &str,
+    start: Where,
+    message: String,
+    reason: String,
+) -> Option<usize> {
+    if list.len() >= MAX_OBSERVATIONS {
+        return None;
+    }
+    list.push(Observation {
+        requirement: id.to_owned(),
+        subject: subject.to_owned(),
+        start,
+        end: None,
+        duration_us: None,
+        message,
+        reason,
+    });
+    Some(list.len() - 1)
+}
+
 /// Violations listed by default (all are counted): a capture full of one fault must not fill
 /// memory or the terminal.
 pub const DEFAULT_MAX_VIOLATIONS: u64 = 1000;
@@ -482,7 +720,7 @@ impl Recorder {
             })
     }
 
-    /// Records a violation of requirement `id`.
+    /// Records a violation of requirement `id`; gives its index in the listing, if listed.
     pub fn violation(
         &mut self,
         id: &str,
@@ -490,7 +728,7 @@ impl Recorder {
         at: Where,
         message: impl Into<String>,
         evidence: Evidence,
-    ) {
+    ) -> Option<usize> {
         self.report.violation_count += 1;
         let t = self.tally(id);
         t.violations += 1;
@@ -511,7 +749,78 @@ impl Recorder {
                 at,
                 message: message.into(),
                 evidence,
+                end: None,
+                duration_us: None,
             });
+            return Some(self.report.violations.len() - 1);
+        }
+        None
+    }
+
+    /// Ends the condition of the violation listed at `index` at `end`.
+    pub fn violation_ended(&mut self, index: usize, end: Where) {
+        if let Some(v) = self.report.violations.get_mut(index) {
+            v.duration_us = match (v.at.time, end.time) {
+                (Some(a), Some(b)) => Some(b.saturating_sub(a)),
+                _ => None,
+            };
+            v.end = Some(end);
+        }
+    }
+
+    /// Records a state the standard or manual allows (not a violation) that begins at
+    /// `start`; gives its index for [`Recorder::ended`], if it is listed.
+    pub fn allowed(
+        &mut self,
+        id: &str,
+        subject: &str,
+        start: Where,
+        message: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> Option<usize> {
+        self.tally(id);
+        let r = &mut self.report;
+        r.allowed_count += 1;
+        observe(
+            &mut r.allowed,
+            id,
+            subject,
+            start,
+            message.into(),
+            reason.into(),
+        )
+    }
+
+    /// Records a check that could not decide, and why.
+    pub fn inconclusive(
+        &mut self,
+        id: &str,
+        subject: &str,
+        at: Where,
+        message: impl Into<String>,
+        reason: impl Into<String>,
+    ) {
+        self.tally(id);
+        let r = &mut self.report;
+        r.inconclusive_count += 1;
+        observe(
+            &mut r.inconclusive,
+            id,
+            subject,
+            at,
+            message.into(),
+            reason.into(),
+        );
+    }
+
+    /// Ends the allowed state listed at `index` at `end`.
+    pub fn ended(&mut self, index: usize, end: Where) {
+        if let Some(o) = self.report.allowed.get_mut(index) {
+            o.duration_us = match (o.start.time, end.time) {
+                (Some(a), Some(b)) => Some(b.saturating_sub(a)),
+                _ => None,
+            };
+            o.end = Some(end);
         }
     }
 

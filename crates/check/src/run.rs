@@ -13,7 +13,7 @@ use crate::error::SetupError;
 use crate::hpd::{HpdChecker, HpdOptions};
 use crate::iolink::{IoLinkChecker, PsxOptions};
 use crate::profinet::{PnChecker, PnOptions};
-use crate::report::{Catalog, Report};
+use crate::report::{Catalog, Policy, Report};
 use drivespec_capture::detect::Format;
 use drivespec_capture::input::Input;
 use drivespec_capture::iolink::{CsvReader, IoLinkReader, JsonLinesReader};
@@ -86,6 +86,8 @@ pub struct RunOptions {
     pub pn: PnOptions,
     /// IO-Link options.
     pub psx: PsxOptions,
+    /// How the verdict is reached (`--strict`, `--require`).
+    pub policy: Policy,
 }
 
 /// Progress of a check: bytes read so far of the file's size.
@@ -281,6 +283,25 @@ fn plan(
     Ok(p)
 }
 
+/// Reads the capture at `path` again from its start for the drives found late (a file
+/// only: memory stays bounded, nothing of the first pass is kept but the drives' places).
+fn second_pass(path: &Path, c: &mut PnChecker<'_>) -> Result<(), RunError> {
+    let file = File::open(path).map_err(|source| RunError::Open {
+        path: path.to_owned(),
+        source,
+    })?;
+    let mut reader = CaptureReader::new(BufReader::with_capacity(1 << 16, file))
+        .map_err(|e| unreadable(path, e.to_string()))?;
+    c.begin_second_pass();
+    let mut decoder = Decoder::default();
+    // A read error was reported by the first pass; the second stops there too.
+    while let Ok(Some(rec)) = reader.next_record() {
+        let pdu = decoder.decode(rec.link_type, rec.data);
+        c.replay_pdu(rec.number, rec.time, &pdu);
+    }
+    Ok(())
+}
+
 /// Checks one file (see the module docs); `progress` is called now and then.
 pub fn check_path(
     spec: &Spec,
@@ -313,7 +334,9 @@ pub fn check_path(
     };
     let mut report = match plan {
         Plan::Profinet => {
-            let mut c = PnChecker::with_catalog(spec, options.pn.clone(), catalog)?;
+            let mut pn = options.pn.clone();
+            pn.rescan = total.is_some() && path != Path::new("-");
+            let mut c = PnChecker::with_catalog(spec, pn, catalog)?;
             let mut reader =
                 CaptureReader::new(reader).map_err(|e| unreadable(path, e.to_string()))?;
             // Records are lent out of the read buffer and decoded in place: no copy per frame.
@@ -335,6 +358,10 @@ pub fn check_path(
                 }
                 n += 1;
                 tick(n);
+            }
+            c.end_of_input();
+            if c.wants_second_pass() {
+                second_pass(path, &mut c)?;
             }
             c.finish(Some(counts))
         }
@@ -408,5 +435,6 @@ pub fn check_path(
     let mut detection = notes;
     detection.append(&mut report.detection);
     report.detection = detection;
+    report.judge(options.policy.clone());
     Ok(report)
 }

@@ -143,3 +143,31 @@ fn an_unknown_baud_rate_is_a_setup_error() {
     let e = check(&spec, &options, std::iter::empty()).err().unwrap();
     assert!(e.to_string().contains("--baud"), "{e}");
 }
+
+/// Without `--baud`, the line speed the recording reads from Pr26 enables the time-out
+/// checks from that read on; a recording without times cannot use it.
+#[test]
+fn the_line_speed_read_from_pr26_enables_the_time_outs() {
+    let spec = Spec::builtin().unwrap();
+    let chunks = hpd_session(&spec, &[]).unwrap();
+    for (name, bytes, timed) in formats(&chunks) {
+        let reader = SerialReader::open(&bytes[..]).unwrap();
+        let r = check(&spec, &HpdOptions::default(), reader).unwrap();
+        let read = r
+            .detection
+            .iter()
+            .any(|d| d.contains("read from the recording"));
+        assert_eq!(read, timed, "{name}: {:?}", r.detection);
+        assert_eq!(
+            r.requirements.contains_key("HPD-FRAME-020"),
+            timed,
+            "{name}"
+        );
+        assert!(
+            !r.notes.iter().any(|n| n.contains("pass --baud")) || !timed,
+            "{name}: {:?}",
+            r.notes
+        );
+        assert!(r.clean(), "{name}: {:#?}", r.violations);
+    }
+}

@@ -2,6 +2,9 @@
 //! without error; the generic checks' findings per file are the expectations in
 //! `real_captures.toml` (none of these captures holds a PSD4xx).
 //!
+//! The text report of each is an insta snapshot (`snapshots/`), with the file named by its
+//! base name.
+//!
 //! Set `DRIVESPEC_CAPTURES` to read another folder; `DRIVESPEC_PRINT_FINDINGS=1` prints the
 //! findings as TOML (to update the expectations after reviewing them).
 #![allow(
@@ -33,6 +36,7 @@ struct Expected {
     rt_cyclic: u64,
     drives: usize,
     violations: BTreeMap<String, u64>,
+    verdict: String,
     #[allow(dead_code)]
     note: Option<String>,
 }
@@ -79,6 +83,8 @@ fn real_captures_check_without_error_and_give_the_recorded_findings() {
             .map(|(k, v)| (k.to_owned(), v))
             .collect();
         let rt = r.frames.get("rt-cyclic").copied().unwrap_or(0);
+        let verdict = serde_json::to_value(r.verdict).unwrap();
+        let verdict = verdict.as_str().unwrap_or("");
         if print {
             println!("[[file]]\nname = {name:?}\nevents = {}\nrt_cyclic = {rt}\ndrives = {}\nviolations = {{ {} }}\n",
                 r.events, r.drives.len(),
@@ -90,9 +96,10 @@ fn real_captures_check_without_error_and_give_the_recorded_findings() {
                     || e.rt_cyclic != rt
                     || e.drives != r.drives.len()
                     || e.violations != found
+                    || e.verdict != verdict
                 {
                     mismatches.push(format!(
-                        "{name}: events {} rt_cyclic {rt} drives {} violations {found:?}",
+                        "{name}: events {} rt_cyclic {rt} drives {} violations {found:?} verdict {verdict}",
                         r.events,
                         r.drives.len()
                     ));
@@ -102,4 +109,33 @@ fn real_captures_check_without_error_and_give_the_recorded_findings() {
         }
     }
     assert!(mismatches.is_empty(), "{}", mismatches.join("\n"));
+}
+
+#[test]
+fn real_captures_give_the_recorded_text_reports() {
+    if std::env::var_os("DRIVESPEC_CAPTURES").is_some() {
+        println!("skipped: the snapshots are of shared/captures, not DRIVESPEC_CAPTURES");
+        return;
+    }
+    let dir = captures_dir();
+    if !dir.is_dir() {
+        println!("skipped: no capture folder at {}", dir.display());
+        return;
+    }
+    let spec = drivespec_spec::Spec::builtin().unwrap();
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let n = p.file_name().unwrap().to_string_lossy().to_string();
+            n.ends_with(".pcap") || n.ends_with(".pcapng")
+        })
+        .collect();
+    names.sort();
+    for path in &names {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mut r = check_path(&spec, path, &RunOptions::default(), &mut |_| {}).unwrap();
+        r.file = Some(name.clone());
+        insta::assert_snapshot!(name, drivespec_check::render::text(&[r]));
+    }
 }

@@ -5,7 +5,7 @@ use crate::{Context, Format, Outcome};
 use anyhow::{anyhow, bail, Context as _, Result};
 use drivespec_check::profinet::Manual;
 use drivespec_check::run::{check_path, Device, InputFormat, Progress, RunOptions};
-use drivespec_check::{render, Report};
+use drivespec_check::{render, Policy, Report};
 use drivespec_spec::hex::parse_int;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -45,6 +45,13 @@ pub struct CheckArgs {
     /// counted).
     #[arg(long, value_name = "N", default_value_t = drivespec_check::DEFAULT_MAX_VIOLATIONS)]
     max_violations: u64,
+    /// Warnings (`should` findings) fail the run too.
+    #[arg(long)]
+    strict: bool,
+    /// Fail a file in which the checks of this family did not run (no drive found); the
+    /// family given with `--device` is required as well.
+    #[arg(long, value_enum, value_name = "FAMILY")]
+    require: Vec<DeviceArg>,
     /// Report format on stdout (the global `--format json` selects json too).
     #[arg(long, value_enum)]
     report: Option<ReportArg>,
@@ -54,7 +61,7 @@ pub struct CheckArgs {
 }
 
 /// `--device`.
-#[derive(Clone, Copy, clap::ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum DeviceArg {
     /// Parker HPD, serial line.
     Hpd,
@@ -116,13 +123,29 @@ fn pair(text: &str, what: &str) -> Result<(u64, u64)> {
     Ok((a, b))
 }
 
+fn device(d: DeviceArg) -> Device {
+    match d {
+        DeviceArg::Hpd => Device::Hpd,
+        DeviceArg::Psd4xx => Device::Psd4xx,
+        DeviceArg::Psx3xx => Device::Psx3xx,
+    }
+}
+
 fn options(args: &CheckArgs) -> Result<RunOptions> {
+    let mut require: Vec<String> = args
+        .require
+        .iter()
+        .chain(args.device.iter())
+        .map(|d| device(*d).as_str().to_owned())
+        .collect();
+    require.sort();
+    require.dedup();
     let mut o = RunOptions {
-        device: args.device.map(|d| match d {
-            DeviceArg::Hpd => Device::Hpd,
-            DeviceArg::Psd4xx => Device::Psd4xx,
-            DeviceArg::Psx3xx => Device::Psx3xx,
-        }),
+        device: args.device.map(device),
+        policy: Policy {
+            strict: args.strict,
+            require,
+        },
         format: match args.input_format {
             FormatArg::Auto => InputFormat::Auto,
             FormatArg::Pcap => InputFormat::Pcap,
@@ -261,7 +284,7 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
     if !errors.is_empty() {
         bail!("{}", errors.join("\ndrivespec: "));
     }
-    Ok(if reports.iter().all(Report::clean) {
+    Ok(if reports.iter().all(Report::passed) {
         Outcome::Pass
     } else {
         Outcome::Fail

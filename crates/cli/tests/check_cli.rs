@@ -204,3 +204,26 @@ fn frame_id_and_offset_locate_the_drive_without_a_connect() {
     assert!(out.contains("found by options"), "{out}");
     assert!(out.contains("PSD-STS-5-SET-1"), "{out}");
 }
+
+#[test]
+fn a_required_family_whose_checks_did_not_run_fails() {
+    let file = capture("psd4xx-clean.pcap.gz");
+    let base = ["check", "--module-ident", "0x1234", "--no-search"];
+    let (code, out, _) = run_with(BIN, &[&base[..], &[&file]].concat(), None, CI);
+    assert_eq!(code, 0, "{out}");
+    assert!(
+        out.contains("result: PASS — PROFINET: pass; PSD4xx: no drive found"),
+        "{out}"
+    );
+    for extra in [["--require", "psd4xx"], ["--device", "psd4xx"]] {
+        let args = [&base[..], &extra[..], &[&file]].concat();
+        let (code, out, _) = run_with(BIN, &args, None, CI);
+        assert_eq!(code, 1, "{extra:?}: {out}");
+        assert!(
+            out.contains(
+                "result: FAIL — PROFINET: pass; PSD4xx: no drive found (required: psd4xx)"
+            ),
+            "{out}"
+        );
+    }
+}

@@ -375,6 +375,14 @@ pub struct PsdScenario {
     pub connect: bool,
     /// Device model of the reference drive.
     pub model: String,
+    /// Cycles (1 ms) the controller leaves the drive idle before the first command.
+    pub idle_start: u32,
+    /// Cycles from the first frame in which the controller is in STOP (start-up: provider
+    /// STOP, IOPS bad, outputs 0).
+    pub startup_stop: u32,
+    /// The controller goes to STOP for 50 cycles during the first positioning run (provider
+    /// STOP, IOPS bad, outputs 0); the drive keeps the last valid outputs (3.9).
+    pub stop_during_run: bool,
 }
 
 impl Default for PsdScenario {
@@ -383,6 +391,9 @@ impl Default for PsdScenario {
             faults: Vec::new(),
             connect: true,
             model: "PSD426".into(),
+            idle_start: 0,
+            startup_stop: 0,
+            stop_during_run: false,
         }
     }
 }
@@ -486,7 +497,7 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
         .map_err(|e| SynthError(e.to_string()))
     };
     let steps = vec![
-        Step::Idle(20),
+        Step::Idle(20 + scenario.idle_start),
         Step::Pkw(read(44)?),
         Step::PkwIdle,
         Step::Pkw(write(44, 5)?),
@@ -513,6 +524,9 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
         ..PkwRequest::default()
     };
     let mut last_in = drive.input();
+    let mut last_valid = Output::default()
+        .to_bytes(&rules)
+        .map_err(|e| SynthError(e.to_string()))?;
     let mut forced_toggle: Option<u32> = None;
     let mut abort_masked = false;
     let mut cycle: u64 = 0;
@@ -601,16 +615,28 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
             let out_bytes = out
                 .to_bytes(&rules)
                 .map_err(|e| SynthError(e.to_string()))?;
+            let stopped = cycle <= u64::from(scenario.startup_stop)
+                || (scenario.stop_during_run
+                    && matches!(step, Step::Run(_))
+                    && (10..60).contains(&step_cycles));
+            // With the controller in STOP the drive keeps the last valid outputs (3.9).
+            if !stopped {
+                last_valid.clone_from(&out_bytes);
+            }
             // The model runs on its own clock from power-up; the capture on wall-clock time.
             let mt = t - START;
             drive
-                .handle_image(mt, &out_bytes)
+                .handle_image(mt, &last_valid)
                 .map_err(|e| SynthError(e.to_string()))?;
             drive.advance(mt + 500);
             while drive.poll_input().is_some() {}
             while drive.poll_event().is_some() {}
-            let mut c_sdu = out_bytes.clone();
-            c_sdu.extend_from_slice(&[0x80, 0x80]);
+            let mut c_sdu = if stopped {
+                vec![0; out_bytes.len()]
+            } else {
+                out_bytes.clone()
+            };
+            c_sdu.extend_from_slice(&[if stopped { 0 } else { 0x80 }, 0x80]);
             w.out_counter = w.out_counter.wrapping_add(32);
             let mut counter = w.out_counter;
             if has(PsdFault::CycleCounterOff) && !planted_counter && cycle == 400 {
@@ -621,7 +647,13 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
                 DEVICE_MAC,
                 CONTROLLER_MAC,
                 0x8892,
-                &rt_cyclic(OUT_FRAME, &c_sdu, usize::from(DATA_LENGTH), counter, 0x35),
+                &rt_cyclic(
+                    OUT_FRAME,
+                    &c_sdu,
+                    usize::from(DATA_LENGTH),
+                    counter,
+                    if stopped { 0x25 } else { 0x35 },
+                ),
             );
             w.frame(t, &f)?;
             // Input frame.
