@@ -20,10 +20,12 @@ macro_rules! say_raw {
 }
 
 mod check_cmd;
+mod completions_cmd;
 mod conform_cmd;
 mod fuzz_cmd;
 mod hpd_cmd;
 mod input;
+mod man_cmd;
 mod pd_cmd;
 mod sim_cmd;
 mod simrun_cmd;
@@ -31,14 +33,14 @@ mod spec_build;
 mod spec_cmd;
 
 use anyhow::{anyhow, bail, Result};
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use drivespec_spec::Spec;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Conformance test suite and protocol fuzzer for PSD4xx, PSx3xx and HPD drives.
 #[derive(Parser)]
-#[command(name = "drivespec", version, about)]
+#[command(name = "drivespec", version = env!("DRIVESPEC_VERSION"))]
 struct Cli {
     /// Load the spec from this folder instead of the built-in one.
     #[arg(long, global = true, value_name = "DIR")]
@@ -79,6 +81,10 @@ enum Command {
         #[command(subcommand)]
         device: PlcDevice,
     },
+    /// Print the shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(completions_cmd::CompletionsArgs),
+    /// Print the man page, or write every page to a folder with --out.
+    Man(man_cmd::ManArgs),
 }
 
 #[derive(Subcommand)]
@@ -197,6 +203,8 @@ fn main() -> ExitCode {
         Command::Plc {
             device: PlcDevice::Hpd(args),
         } => hpd_cmd::plc(args, &ctx),
+        Command::Completions(args) => completions_cmd::run(args, Cli::command()),
+        Command::Man(args) => man_cmd::run(args, Cli::command()),
     };
     match result {
         Ok(Outcome::Pass) => ExitCode::SUCCESS,
