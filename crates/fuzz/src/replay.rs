@@ -610,7 +610,7 @@ mod tests {
     #[test]
     fn the_readme_example_loads() {
         let readme = include_str!("../README.md");
-        let from = readme.find("### Replay files").unwrap();
+        let from = readme.find("## Replay files").unwrap();
         let block = readme[from..].split("```json").nth(1).unwrap();
         let json = block.split("```").next().unwrap();
         let r = Replay::from_json(json, "README.md").unwrap();
