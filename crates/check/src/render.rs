@@ -6,7 +6,7 @@
 use crate::report::{format_time, Report, SCHEMA};
 use crate::timeline::Timeline;
 use drivespec_report::escape as xml;
-use drivespec_report::junit::{self as xml_junit, Case, Form, Outcome, Suite};
+use drivespec_report::junit::{self as xml_junit, Case, Outcome, Problem, Suite};
 use drivespec_report::svg::polyline;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -149,6 +149,12 @@ pub fn text(reports: &[Report]) -> String {
         if let Some(e) = &r.error {
             let _ = writeln!(o, "  error: reading stopped: {}", e.message);
         }
+        if r.interrupted {
+            let _ = writeln!(
+                o,
+                "  interrupted: reading stopped before the end; this covers what was read"
+            );
+        }
         let verdict = if r.error.is_some() {
             "UNREADABLE (checked up to the error)"
         } else if r.violation_count > 0 {
@@ -161,8 +167,9 @@ pub fn text(reports: &[Report]) -> String {
     o
 }
 
-/// JUnit XML: one test suite per file, one test case per requirement checked (failed when
-/// violated, with the listed violations), plus a test case for a read error.
+/// JUnit XML: one test suite per file, named by the file's name, one test case per
+/// requirement checked (a `<failure>` when violated, with the listed violations), and an
+/// `<error>` test case when the file could not be read to its end.
 pub fn junit(reports: &[Report]) -> String {
     let suites = reports
         .iter()
@@ -178,17 +185,18 @@ pub fn junit(reports: &[Report]) -> String {
                         for v in r.violations.iter().filter(|v| &v.requirement == id) {
                             let _ = writeln!(text, "{}: {}: {}", v.at, v.subject, v.message);
                         }
-                        Outcome::Failed {
+                        Outcome::Failed(Problem {
                             message: format!("{} violation(s): {}", t.violations, t.text),
                             kind: t.level.clone(),
                             text: Some(text),
-                        }
+                        })
                     };
                     Case {
                         name: id.clone(),
                         classname: format!("drivespec.check.{}", r.family),
                         time_ms: 0.0,
                         outcome,
+                        output: None,
                     }
                 })
                 .collect();
@@ -197,23 +205,44 @@ pub fn junit(reports: &[Report]) -> String {
                     name: "readable".to_owned(),
                     classname: "drivespec.check.input".to_owned(),
                     time_ms: 0.0,
-                    outcome: Outcome::Failed {
+                    outcome: Outcome::Errored(Problem {
                         message: e.message.clone(),
                         kind: "input".to_owned(),
                         text: None,
-                    },
+                    }),
+                    output: None,
                 });
             }
+            let name = r.file.as_deref().map_or("stream", |f| {
+                std::path::Path::new(f)
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .unwrap_or(f)
+            });
+            let mut properties = Vec::new();
+            if let Some(f) = &r.file {
+                properties.push(("file".to_owned(), f.clone()));
+            }
+            if r.interrupted {
+                properties.push(("interrupted".to_owned(), "true".to_owned()));
+            }
             Suite {
-                name: r.file.as_deref().unwrap_or("stream").to_owned(),
-                properties: Vec::new(),
+                name: name.to_owned(),
+                time_ms: r.timing.map(|(_, ms)| ms),
+                properties,
                 cases,
             }
         })
         .collect();
+    let started = reports
+        .iter()
+        .filter_map(|r| r.timing)
+        .map(|(t, _)| t)
+        .min();
     xml_junit::Document {
         name: "drivespec check".to_owned(),
-        form: Form::Counted,
+        timestamp: started.map(xml_junit::timestamp),
+        hostname: started.map(|_| xml_junit::hostname()),
         suites,
     }
     .to_xml()

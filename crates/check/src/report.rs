@@ -291,6 +291,14 @@ pub struct Report {
     /// Reading stopped early: why and where.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<InputFault>,
+    /// Reading was stopped by the caller (a signal) before the end of the file: the report
+    /// covers what was read. Present only then.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub interrupted: bool,
+    /// When the check started and how long it took (JUnit); not in the JSON, which stays the
+    /// same for the same recording.
+    #[serde(skip)]
+    pub timing: Option<(std::time::SystemTime, f64)>,
     /// Position, speed and bits over time per positioning drive (HTML report only).
     #[serde(skip)]
     pub timelines: Vec<Timeline>,
@@ -315,6 +323,8 @@ impl Report {
             notes: Vec::new(),
             notes_dropped: 0,
             error: None,
+            interrupted: false,
+            timing: None,
             timelines: Vec::new(),
         }
     }
