@@ -284,12 +284,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             .iter()
             .any(|r| r.got.as_ref().is_some_and(|a| !a.is_silence()));
         heard |= answered || !run.outcome.failed();
-        if !heard && n + 1 >= MUTE_CASES && !opts.stop.load(Ordering::Relaxed) {
-            return Err(ConformError::Mute {
-                cases: n + 1,
-                dut: opts.dut.to_string(),
-            });
-        }
+        let mute = !heard && n + 1 >= MUTE_CASES && !opts.stop.load(Ordering::Relaxed);
         let wall_ms = started.elapsed().as_secs_f64() * 1000.0;
         let status = match (&run.outcome, known) {
             (Outcome::Pass, None) if run.findings.is_empty() => Status::Pass,
@@ -318,6 +313,12 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             elapsed_s: run_started.elapsed().as_secs_f64(),
         };
         show(progress, mode, opts.colour, &line);
+        if mute {
+            return Err(ConformError::Mute {
+                cases: n + 1,
+                dut: opts.dut.to_string(),
+            });
+        }
         if status == Status::Fail && opts.fail_fast {
             stop = true;
         }

@@ -129,8 +129,13 @@ impl Document {
 
 impl Suite {
     fn wall_ms(&self) -> f64 {
-        self.time_ms
-            .unwrap_or_else(|| self.cases.iter().map(|c| c.time_ms).sum())
+        self.time_ms.unwrap_or_else(|| {
+            self.cases
+                .iter()
+                .map(|c| c.time_ms)
+                .filter(|ms| ms.is_finite() && *ms > 0.0)
+                .sum()
+        })
     }
 }
 
