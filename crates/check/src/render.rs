@@ -6,7 +6,7 @@
 use crate::report::{format_time, Observation, Report, Verdict, SCHEMA};
 use crate::timeline::Timeline;
 use drivespec_report::escape as xml;
-use drivespec_report::junit::{self as xml_junit, Case, Form, Outcome, Suite};
+use drivespec_report::junit::{self as xml_junit, Case, Outcome, Problem, Suite};
 use drivespec_report::svg::polyline;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -181,6 +181,12 @@ pub fn text(reports: &[Report]) -> String {
         if let Some(e) = &r.error {
             let _ = writeln!(o, "  error: reading stopped: {}", e.message);
         }
+        if r.interrupted {
+            let _ = writeln!(
+                o,
+                "  interrupted: reading stopped before the end; this covers what was read"
+            );
+        }
         let mut line = format!("  result: {}", r.verdict.as_str());
         let scopes = r.scope_line();
         if !scopes.is_empty() {
@@ -247,8 +253,11 @@ pub fn duration(us: u64) -> String {
     }
 }
 
-/// JUnit XML: one test suite per file, one test case per requirement checked (failed when
-/// violated, with the listed violations), plus a test case for a read error.
+/// JUnit XML: one test suite per file, named by the file's name, one test case per
+/// requirement checked (a `<failure>` when a `must` requirement, or any under `--strict`, is
+/// violated; warnings pass with the listed violations as output), one per group of checks
+/// (skipped, or failed when required, if it did not run), and an `<error>` test case when the
+/// file could not be read to its end.
 pub fn junit(reports: &[Report]) -> String {
     let suites = reports
         .iter()
@@ -262,25 +271,28 @@ pub fn junit(reports: &[Report]) -> String {
                         let _ = writeln!(text, "{}: {}: {}", v.at, v.subject, v.message);
                     }
                     let fails = t.level == "must" || r.policy.strict;
-                    let outcome = if t.violations == 0 {
-                        Outcome::Passed
+                    let (outcome, output) = if t.violations == 0 {
+                        (Outcome::Passed, None)
                     } else if !fails {
-                        Outcome::PassedWithOutput(format!(
+                        let warnings = format!(
                             "{} warning(s) [{}]: {}\n{text}",
                             t.violations, t.level, t.text
-                        ))
+                        );
+                        (Outcome::Passed, Some(warnings))
                     } else {
-                        Outcome::Failed {
+                        let failed = Outcome::Failed(Problem {
                             message: format!("{} violation(s): {}", t.violations, t.text),
                             kind: t.level.clone(),
                             text: Some(text),
-                        }
+                        });
+                        (failed, None)
                     };
                     Case {
                         name: id.clone(),
                         classname: format!("drivespec.check.{}", r.family),
                         time_ms: 0.0,
                         outcome,
+                        output,
                     }
                 })
                 .collect();
@@ -289,11 +301,12 @@ pub fn junit(reports: &[Report]) -> String {
                     name: "readable".to_owned(),
                     classname: "drivespec.check.input".to_owned(),
                     time_ms: 0.0,
-                    outcome: Outcome::Failed {
+                    outcome: Outcome::Errored(Problem {
                         message: e.message.clone(),
                         kind: "input".to_owned(),
                         text: None,
-                    },
+                    }),
+                    output: None,
                 });
             }
             for sc in &r.scopes {
@@ -304,21 +317,22 @@ pub fn junit(reports: &[Report]) -> String {
                 let outcome = match (&sc.why_not, required) {
                     (None, _) => Outcome::Passed,
                     (Some(why), false) => Outcome::Skipped(why.clone()),
-                    (Some(why), true) => Outcome::Failed {
+                    (Some(why), true) => Outcome::Failed(Problem {
                         message: format!("required checks did not run: {why}"),
                         kind: "required".to_owned(),
                         text: None,
-                    },
+                    }),
                 };
                 cases.push(Case {
                     name: format!("{} checks ran", sc.name),
                     classname: "drivespec.check.scope".to_owned(),
                     time_ms: 0.0,
                     outcome,
+                    output: None,
                 });
             }
             let must = r.must_count();
-            let properties = vec![
+            let mut properties = vec![
                 ("verdict".to_owned(), r.verdict.as_str().to_owned()),
                 ("must_violations".to_owned(), must.to_string()),
                 (
@@ -328,16 +342,35 @@ pub fn junit(reports: &[Report]) -> String {
                 ("allowed_states".to_owned(), r.allowed_count.to_string()),
                 ("inconclusive".to_owned(), r.inconclusive_count.to_string()),
             ];
+            let name = r.file.as_deref().map_or("stream", |f| {
+                std::path::Path::new(f)
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .unwrap_or(f)
+            });
+            if let Some(f) = &r.file {
+                properties.push(("file".to_owned(), f.clone()));
+            }
+            if r.interrupted {
+                properties.push(("interrupted".to_owned(), "true".to_owned()));
+            }
             Suite {
-                name: r.file.as_deref().unwrap_or("stream").to_owned(),
+                name: name.to_owned(),
+                time_ms: r.timing.map(|(_, ms)| ms),
                 properties,
                 cases,
             }
         })
         .collect();
+    let started = reports
+        .iter()
+        .filter_map(|r| r.timing)
+        .map(|(t, _)| t)
+        .min();
     xml_junit::Document {
         name: "drivespec check".to_owned(),
-        form: Form::Counted,
+        timestamp: started.map(xml_junit::timestamp),
+        hostname: started.map(|_| xml_junit::hostname()),
         suites,
     }
     .to_xml()

@@ -314,6 +314,14 @@ pub struct Report {
     pub policy: Policy,
     /// The verdict under `policy`: `pass`, `warn`, `fail` or `unreadable`.
     pub verdict: Verdict,
+    /// Reading was stopped by the caller (a signal) before the end of the file: the report
+    /// covers what was read. Present only then.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub interrupted: bool,
+    /// When the check started and how long it took (JUnit); not in the JSON, which stays the
+    /// same for the same recording.
+    #[serde(skip)]
+    pub timing: Option<(std::time::SystemTime, f64)>,
     /// Position, speed and bits over time per positioning drive (HTML report only).
     #[serde(skip)]
     pub timelines: Vec<Timeline>,
@@ -440,6 +448,8 @@ impl Report {
             scopes: Vec::new(),
             policy: Policy::default(),
             verdict: Verdict::Pass,
+            interrupted: false,
+            timing: None,
             timelines: Vec::new(),
         }
     }

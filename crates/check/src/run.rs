@@ -27,6 +27,7 @@ use std::fs::File;
 use std::io::{self, BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// A device family to check.
@@ -88,6 +89,9 @@ pub struct RunOptions {
     pub psx: PsxOptions,
     /// How the verdict is reached (`--strict`, `--require`).
     pub policy: Policy,
+    /// Set by the caller to stop reading; the report covers what was read and is marked
+    /// interrupted.
+    pub stop: Arc<AtomicBool>,
 }
 
 /// Progress of a check: bytes read so far of the file's size.
@@ -309,6 +313,7 @@ pub fn check_path(
     options: &RunOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Report, RunError> {
+    let (started, clock) = (std::time::SystemTime::now(), std::time::Instant::now());
     let catalog = Arc::new(Catalog::new(spec).map_err(SetupError::from)?);
     let mut notes = Vec::new();
     let (rest, total, start) = open(path)?;
@@ -324,6 +329,8 @@ pub fn check_path(
             count: count.clone(),
         },
     );
+    let mut interrupted = false;
+    // Progress now and then; false when the caller asks to stop.
     let mut tick = |n: u64| {
         if n % PROGRESS_EVERY == 0 {
             progress(Progress {
@@ -331,6 +338,11 @@ pub fn check_path(
                 total,
             });
         }
+        if options.stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            return false;
+        }
+        true
     };
     let mut report = match plan {
         Plan::Profinet => {
@@ -357,7 +369,9 @@ pub fn check_path(
                     }
                 }
                 n += 1;
-                tick(n);
+                if !tick(n) {
+                    break;
+                }
             }
             c.end_of_input();
             if c.wants_second_pass() {
@@ -388,7 +402,9 @@ pub fn check_path(
                     }
                 }
                 n += 1;
-                tick(n);
+                if !tick(n) {
+                    break;
+                }
             }
             c.finish()
         }
@@ -422,7 +438,9 @@ pub fn check_path(
                     }
                 }
                 n += 1;
-                tick(n);
+                if !tick(n) {
+                    break;
+                }
             }
             c.finish()
         }
@@ -432,6 +450,8 @@ pub fn check_path(
         total,
     });
     report.file = Some(path.display().to_string());
+    report.interrupted = interrupted;
+    report.timing = Some((started, clock.elapsed().as_secs_f64() * 1000.0));
     let mut detection = notes;
     detection.append(&mut report.detection);
     report.detection = detection;

@@ -1,6 +1,7 @@
 //! `drivespec check`: recorded traffic against the spec. Parsing, progress and
 //! printing only; the work is in `drivespec_check`.
 
+use crate::interrupt::Interrupt;
 use crate::{Context, Format, Outcome};
 use anyhow::{anyhow, bail, Context as _, Result};
 use drivespec_check::profinet::Manual;
@@ -245,7 +246,9 @@ fn write_reports(dir: &Path, reports: &[Report]) -> Result<()> {
 /// Runs `drivespec check`.
 pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
     let spec = ctx.spec()?;
-    let options = options(&args)?;
+    let interrupt = Interrupt::install(None)?;
+    let mut options = options(&args)?;
+    options.stop = interrupt.flag();
     let format = args.report.unwrap_or(match ctx.format {
         Format::Json => ReportArg::Json,
         _ => ReportArg::Text,
@@ -255,6 +258,9 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
     let mut reports = Vec::new();
     let mut errors = Vec::new();
     for file in &args.files {
+        if interrupt.stopped() {
+            break;
+        }
         let mut bar = Bar {
             ci,
             tty,
@@ -280,6 +286,10 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
     say_raw!("{out}")?;
     if let Some(dir) = &args.report_dir {
         write_reports(dir, &reports)?;
+    }
+    if let (Some(code), Some(cause)) = (interrupt.exit_code(), interrupt.cause()) {
+        eprintln!("drivespec: interrupted by {cause}: the report covers what was read");
+        return Ok(Outcome::Stopped(code));
     }
     if !errors.is_empty() {
         bail!("{}", errors.join("\ndrivespec: "));

@@ -1,14 +1,24 @@
 //! `drivespec conform`: argument parsing and printing around `drivespec_conform::run`.
 
+use crate::interrupt::{parse_duration, Interrupt};
 use crate::{json, Context, Format, Outcome};
 use anyhow::{bail, Result};
 use drivespec_conform::dut::Dut;
 use drivespec_conform::report::Status;
+use drivespec_conform::runner::{paint, RED};
 use drivespec_conform::select::LevelFilter;
+use drivespec_conform::select::{closest, did_you_mean};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::{Options, Progress};
 use drivespec_spec::FamilyId;
 use std::path::PathBuf;
+use std::time::Duration;
+
+/// Schema of `drivespec conform --format json` on stdout (crates/conform/README.md).
+const SUMMARY_SCHEMA: &str = "drivespec-conform-summary/1";
+
+/// Schema of `drivespec conform --list --format json` (crates/conform/README.md).
+const LIST_SCHEMA: &str = "drivespec-conform-list/1";
 
 /// Run the conformance suite against a device under test.
 #[derive(clap::Args)]
@@ -64,9 +74,16 @@ pub struct ConformArgs {
     /// HTML report file (default DIR/conform.html).
     #[arg(long, value_name = "FILE")]
     html: Option<PathBuf>,
-    /// No progress output.
-    #[arg(long)]
+    /// Print only the failures, as they happen, and the summary.
+    #[arg(long, conflicts_with = "verbose")]
     quiet: bool,
+    /// Print one line per case, passing or not.
+    #[arg(long)]
+    verbose: bool,
+    /// Stop the run after this long (90s, 10m, 2h), write the reports of the cases that ran
+    /// (the rest `not-run`) and exit 124.
+    #[arg(long, value_name = "TIME", value_parser = parse_duration)]
+    timeout: Option<Duration>,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -83,14 +100,16 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
         match FamilyId::parse(&args.family) {
             Some(f) => vec![f],
             None => bail!(
-                "unknown family {:?}: hpd, psd4xx, psx3xx or all",
-                args.family
+                "unknown family {:?} (hpd, psd4xx, psx3xx or all){}",
+                args.family,
+                did_you_mean(&closest(&args.family, ["hpd", "psd4xx", "psx3xx", "all"]))
             ),
         }
     };
     let dut: Dut = args.dut.parse()?;
     let spec = ctx.spec()?;
     let readings = strict_readings(&spec, &families, &args.reading)?;
+    let interrupt = Interrupt::install(args.timeout)?;
     let opts = Options {
         families,
         dut,
@@ -118,16 +137,26 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
         no_reports: false,
         progress: if args.quiet {
             Progress::Quiet
+        } else if args.verbose {
+            Progress::Verbose
         } else {
             Progress::Auto
         },
+        colour: crate::colour(&std::io::stderr()),
         command: "drivespec conform".to_owned(),
+        stop: interrupt.flag(),
     };
     let mut err = std::io::stderr();
     let summary = drivespec_conform::run(&spec, &opts, &mut err)?;
     if opts.list {
         match ctx.format {
-            Format::Json => say!("{}", json(&serde_json::json!({ "cases": summary.listed })))?,
+            Format::Json => say!(
+                "{}",
+                json(&serde_json::json!({
+                    "schema": LIST_SCHEMA,
+                    "cases": summary.listed,
+                }))
+            )?,
             Format::Text => {
                 for c in &summary.listed {
                     say!("{:<48} {:<6} {}", c.id, c.level.as_str(), c.description)?;
@@ -143,11 +172,21 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
         Format::Json => say!(
             "{}",
             json(&serde_json::json!({
+                "schema": SUMMARY_SCHEMA,
                 "summary": s,
+                "failures": r.cases.iter().filter(|c| c.status == Status::Fail).map(|c| {
+                    serde_json::json!({
+                        "id": c.id,
+                        "requirement": c.failure.as_ref().and_then(|f| f.broken()).map(|b| &b.id),
+                        "message": c.failure.as_ref().map(|f| &f.message),
+                        "replay": c.replay,
+                    })
+                }).collect::<Vec<_>>(),
                 "reports": summary.written,
             }))
         )?,
         Format::Text => {
+            recap(r)?;
             for c in r.cases.iter().filter(|c| c.status == Status::Fixed) {
                 say!(
                     "fixed: {} passes; remove it from the expectations file",
@@ -181,13 +220,47 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
             for w in &summary.written {
                 say!("report: {}", w.display())?;
             }
+            if let (Some(cause), true) = (interrupt.cause(), s.interrupted) {
+                say!(
+                    "interrupted by {cause}: {} case(s) not run; the reports cover the cases that ran",
+                    s.not_run
+                )?;
+            }
         }
+    }
+    if let Some(code) = interrupt.exit_code() {
+        return Ok(Outcome::Stopped(code));
     }
     Ok(if summary.exit_code() == 0 {
         Outcome::Pass
     } else {
         Outcome::Fail
     })
+}
+
+/// The unexpected failures again, each with its broken requirement, what the manual allows,
+/// what came and the replay command.
+fn recap(r: &drivespec_conform::report::Report) -> Result<()> {
+    let failed: Vec<_> = r
+        .cases
+        .iter()
+        .filter(|c| c.status == Status::Fail)
+        .collect();
+    if failed.is_empty() {
+        return Ok(());
+    }
+    let colour = crate::colour(&std::io::stdout());
+    say!("failures ({}):", failed.len())?;
+    for c in failed {
+        say!("{} {}", paint(colour, RED, "FAIL"), c.id)?;
+        for l in c.failure.iter().flat_map(|f| f.headline()) {
+            say!("  {l}")?;
+        }
+        if let Some(line) = &c.replay {
+            say!("  replay: {line}")?;
+        }
+    }
+    Ok(())
 }
 
 /// The `--reading OPTION=READING` pairs, each checked against the errata of the selected

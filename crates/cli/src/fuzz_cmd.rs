@@ -1,15 +1,20 @@
 //! `drivespec fuzz`: argument parsing and printing around `drivespec_fuzz`
 //! (crates/fuzz/README.md).
 
+use crate::interrupt::{parse_duration, Interrupt};
 use crate::{json, Context, Format, Outcome};
 use anyhow::{bail, Context as _, Result};
 use drivespec_conform::dut::Dut;
+use drivespec_conform::select::{closest, did_you_mean};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
 use drivespec_fuzz::{self as fuzz, Options, Replay, ReplayOutcome};
 use drivespec_spec::FamilyId;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
+
+/// Schema of `drivespec fuzz --format json` on stdout (crates/conform/README.md).
+const SUMMARY_SCHEMA: &str = "drivespec-fuzz-summary/1";
 
 /// Fuzz a device under test with sequences generated from the spec (exit 1 on findings).
 #[derive(clap::Args)]
@@ -31,6 +36,10 @@ pub struct FuzzArgs {
     /// Wall-clock budget: 90s, 10m, 2h (a plain number is seconds).
     #[arg(long, value_name = "TIME", value_parser = parse_duration)]
     duration: Option<Duration>,
+    /// Stop the whole run (fuzzing and minimising) after this long, write the reports of what
+    /// ran and exit 124: 90s, 10m, 2h.
+    #[arg(long, value_name = "TIME", value_parser = parse_duration)]
+    timeout: Option<Duration>,
     /// Folder of the reports and replay files.
     #[arg(long, default_value = "reports/fuzz", value_name = "DIR")]
     out: PathBuf,
@@ -57,30 +66,17 @@ pub struct FuzzArgs {
     quiet: bool,
 }
 
-/// `90s`, `10m`, `2h`, `500ms`, or seconds.
-fn parse_duration(text: &str) -> Result<Duration, String> {
-    let t = text.trim();
-    let split = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
-    let (num, unit) = t.split_at(split);
-    let n: u64 = num
-        .parse()
-        .map_err(|_| format!("{text:?}: expected a number with s, m, h or ms"))?;
-    let secs = |k: u64| Duration::from_secs(n.saturating_mul(k));
-    match unit.trim() {
-        "" | "s" => Ok(secs(1)),
-        "m" | "min" => Ok(secs(60)),
-        "h" => Ok(secs(3600)),
-        "ms" => Ok(Duration::from_millis(n)),
-        other => Err(format!("unknown unit {other:?} (s, m, h, ms)")),
-    }
-}
-
 /// Runs `drivespec fuzz`.
 pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
     let Some(family) = FamilyId::parse(&args.family) else {
-        bail!("unknown family {:?}: hpd, psd4xx or psx3xx", args.family)
+        bail!(
+            "unknown family {:?} (hpd, psd4xx or psx3xx){}",
+            args.family,
+            did_you_mean(&closest(&args.family, ["hpd", "psd4xx", "psx3xx"]))
+        )
     };
     let dut: Dut = args.dut.parse()?;
+    let interrupt = Interrupt::install(args.timeout)?;
     let opts = Options {
         family,
         dut,
@@ -104,6 +100,7 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
         max_findings: args.max_findings,
         minimize_runs: args.minimize_runs,
         command: "drivespec fuzz".to_owned(),
+        stop: interrupt.flag(),
     };
     let spec = ctx.spec()?;
     if let Some(file) = &args.replay {
@@ -127,6 +124,7 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
         Format::Json => say!(
             "{}",
             json(&serde_json::json!({
+                "schema": SUMMARY_SCHEMA,
                 "summary": summary.report.summary,
                 "sequences": s.sequences,
                 "inputs": s.inputs,
@@ -160,7 +158,13 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
             for w in &summary.written {
                 say!("report: {}", w.display())?;
             }
+            if let Some(cause) = interrupt.cause() {
+                say!("interrupted by {cause}: the reports cover the sequences run")?;
+            }
         }
+    }
+    if let Some(code) = interrupt.exit_code() {
+        return Ok(Outcome::Stopped(code));
     }
     Ok(if summary.exit_code() == 0 {
         Outcome::Pass

@@ -25,6 +25,7 @@ mod conform_cmd;
 mod fuzz_cmd;
 mod hpd_cmd;
 mod input;
+mod interrupt;
 mod man_cmd;
 mod pd_cmd;
 mod sim_cmd;
@@ -122,12 +123,15 @@ pub enum Format {
     Json,
 }
 
-/// What a command found: exit 0 = pass, 1 = violations or failures found.
+/// What a command found: exit 0 = pass, 1 = violations or failures found, 124/130/143 =
+/// stopped by the time limit, SIGINT or SIGTERM.
 pub enum Outcome {
     /// Nothing wrong.
     Pass,
     /// Violations or failures found.
     Fail,
+    /// Stopped by a signal or the time limit, with the exit code that says which.
+    Stopped(u8),
 }
 
 /// What every command gets: where the spec comes from and how to print.
@@ -159,6 +163,11 @@ impl Context {
 }
 
 pub use drivespec_report::json;
+
+/// Whether to colour what goes to `stream`: a terminal, and `NO_COLOR` unset or empty.
+pub fn colour(stream: &impl std::io::IsTerminal) -> bool {
+    stream.is_terminal() && std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty())
+}
 
 /// Standard output could not be written: a reader that went away (a broken pipe ends the
 /// command quietly with exit 0) or a write error (exit 2).
@@ -209,6 +218,7 @@ fn main() -> ExitCode {
     match result {
         Ok(Outcome::Pass) => ExitCode::SUCCESS,
         Ok(Outcome::Fail) => ExitCode::from(1),
+        Ok(Outcome::Stopped(code)) => ExitCode::from(code),
         Err(e) => match e.downcast_ref::<StdoutClosed>() {
             Some(StdoutClosed(io)) if io.kind() == std::io::ErrorKind::BrokenPipe => {
                 ExitCode::SUCCESS

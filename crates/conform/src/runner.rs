@@ -19,23 +19,28 @@ use crate::suite::{self, Session, Settings, SetupError, Suite};
 use drivespec_spec::{FamilyId, Level, Requirement, Spec};
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Failing cases without a single byte from the device after which a run stops as a set-up
 /// error: a wrong port, bit rate or address would otherwise cost the whole suite's time-outs.
 const MUTE_CASES: usize = 10;
 
-/// How progress is shown.
+/// How progress is shown. Every mode but `Quiet` ends with nothing more: the recap of the
+/// failures and the summary are the caller's ([`Summary::report`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Progress {
     /// A progress bar on a terminal, plain lines otherwise and when `CI=true`.
     #[default]
     Auto,
-    /// A bar redrawn in place.
+    /// A bar redrawn in place; failures as they happen.
     Bar,
-    /// One line per case.
+    /// Failures as they happen and a progress line at every tenth of the run.
     Plain,
-    /// Nothing but the summary.
+    /// One line per case; failures with their details.
+    Verbose,
+    /// Failures as they happen, nothing else.
     Quiet,
 }
 
@@ -91,8 +96,13 @@ pub struct Options {
     pub no_reports: bool,
     /// How progress is shown.
     pub progress: Progress,
+    /// Colour the progress output (ANSI; for terminals).
+    pub colour: bool,
     /// The command that starts a run, for replay lines (`drivespec conform`).
     pub command: String,
+    /// Set by the caller to stop the run after the current case; the rest is `not-run` and
+    /// the report is marked interrupted.
+    pub stop: Arc<AtomicBool>,
 }
 
 impl Default for Options {
@@ -113,7 +123,9 @@ impl Default for Options {
             html: None,
             no_reports: false,
             progress: Progress::Auto,
+            colour: false,
             command: "drivespec conform".to_owned(),
+            stop: Arc::default(),
         }
     }
 }
@@ -189,6 +201,11 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     for f in wanted {
         suites.push(suite::suite(spec, f, &settings)?);
     }
+    let ids: Vec<&str> = suites
+        .iter()
+        .flat_map(|s| s.cases().iter().map(|c| c.id.as_str()))
+        .collect();
+    selection.check_patterns(&ids)?;
     let mut plan: Vec<(usize, usize)> = Vec::new();
     for (si, s) in suites.iter().enumerate() {
         for (ci, c) in s.cases().iter().enumerate() {
@@ -196,6 +213,9 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
                 plan.push((si, ci));
             }
         }
+    }
+    if plan.is_empty() {
+        return Err(SelectError::Empty.into());
     }
     if opts.list {
         let listed = plan
@@ -226,8 +246,12 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     }
     let transport = sessions.first().map(|s| s.describe()).unwrap_or_default();
     let mode = opts.progress.resolve();
+    let run_started = Instant::now();
+    let started_at = std::time::SystemTime::now();
+    let mut failed = 0usize;
     let mut results: Vec<CaseReport> = Vec::new();
     let mut stop = false;
+    let mut interrupted = false;
     let mut heard = false;
     let total = plan.len();
     for (n, (si, ci)) in plan.iter().enumerate() {
@@ -238,6 +262,10 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             continue;
         };
         let known = expectations.known(&info.id);
+        if !interrupted && opts.stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            stop = true;
+        }
         if stop {
             results.push(case_report(
                 info,
@@ -256,12 +284,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             .iter()
             .any(|r| r.got.as_ref().is_some_and(|a| !a.is_silence()));
         heard |= answered || !run.outcome.failed();
-        if !heard && n + 1 >= MUTE_CASES {
-            return Err(ConformError::Mute {
-                cases: n + 1,
-                dut: opts.dut.to_string(),
-            });
-        }
+        let mute = !heard && n + 1 >= MUTE_CASES && !opts.stop.load(Ordering::Relaxed);
         let wall_ms = started.elapsed().as_secs_f64() * 1000.0;
         let status = match (&run.outcome, known) {
             (Outcome::Pass, None) if run.findings.is_empty() => Status::Pass,
@@ -279,15 +302,23 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             Outcome::Fail(f) if status == Status::Fail => f.headline(),
             _ => Vec::new(),
         };
-        show(
-            progress,
-            mode,
-            (n + 1, total),
-            &info.id,
+        failed += usize::from(status == Status::Fail);
+        let line = Line {
+            at: (n + 1, total),
+            id: &info.id,
             status,
-            &headline,
-            replay.as_deref(),
-        );
+            headline: &headline,
+            replay: replay.as_deref(),
+            failed,
+            elapsed_s: run_started.elapsed().as_secs_f64(),
+        };
+        show(progress, mode, opts.colour, &line);
+        if mute {
+            return Err(ConformError::Mute {
+                cases: n + 1,
+                dut: opts.dut.to_string(),
+            });
+        }
         if status == Status::Fail && opts.fail_fast {
             stop = true;
         }
@@ -303,7 +334,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     if mode == Progress::Bar {
         let _ = writeln!(progress);
     }
-    let report = build_report(
+    let mut report = build_report(
         opts,
         &settings,
         &suites,
@@ -312,6 +343,11 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         &expectations,
         spec,
     );
+    report.summary.interrupted = interrupted;
+    report.timing = Some(report::Timing {
+        started: started_at,
+        wall_ms: run_started.elapsed().as_secs_f64() * 1000.0,
+    });
     let written = if opts.no_reports {
         Vec::new()
     } else {
@@ -324,43 +360,85 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     })
 }
 
-/// One case's progress; a failure shows its headline (the broken requirement first) and the
-/// replay command.
-fn show(
-    out: &mut dyn Write,
-    mode: Progress,
-    (n, total): (usize, usize),
-    id: &str,
+/// What the progress output says after one case.
+struct Line<'a> {
+    /// This case's number and the number of cases.
+    at: (usize, usize),
+    id: &'a str,
     status: Status,
-    headline: &[String],
-    replay: Option<&str>,
-) {
+    /// The failure's headline (unexpected failures).
+    headline: &'a [String],
+    replay: Option<&'a str>,
+    /// Unexpected failures so far.
+    failed: usize,
+    /// Seconds since the first case.
+    elapsed_s: f64,
+}
+
+/// `text` in the ANSI colour `code` when `on`.
+pub fn paint(on: bool, code: &str, text: &str) -> String {
+    if on {
+        format!("\x1b[{code}m{text}\x1b[0m")
+    } else {
+        text.to_owned()
+    }
+}
+
+/// Red, for failures.
+pub const RED: &str = "1;31";
+
+/// One case's progress. A failure shows, in every mode, its headline (the broken requirement,
+/// what the manual allows and what came) and the replay command.
+fn show(out: &mut dyn Write, mode: Progress, colour: bool, l: &Line<'_>) {
+    let (n, total) = l.at;
+    let fail = l.status == Status::Fail;
     let details = |out: &mut dyn Write| {
-        for l in headline {
-            let _ = writeln!(out, "  {l}");
+        let _ = writeln!(out, "{} {} ({n}/{total})", paint(colour, RED, "FAIL"), l.id);
+        for h in l.headline {
+            let _ = writeln!(out, "  {h}");
         }
-        if let Some(r) = replay {
+        if let Some(r) = l.replay {
             let _ = writeln!(out, "  replay: {r}");
         }
     };
     match mode {
-        Progress::Quiet | Progress::Auto => {}
-        Progress::Plain => {
-            let _ = writeln!(out, "{:<16} {id} ({n}/{total})", status.as_str());
-            if status == Status::Fail {
+        Progress::Auto => {}
+        Progress::Quiet => {
+            if fail {
                 details(out);
             }
         }
+        Progress::Verbose => {
+            if fail {
+                details(out);
+            } else {
+                let _ = writeln!(out, "{:<16} {} ({n}/{total})", l.status.as_str(), l.id);
+            }
+        }
+        Progress::Plain => {
+            if fail {
+                details(out);
+            }
+            let tenth = |k: usize| k * 10 / total.max(1);
+            if total >= 20 && tenth(n) > tenth(n.saturating_sub(1)) {
+                let _ = writeln!(
+                    out,
+                    "progress: {n}/{total} cases ({}%), {} failed, {:.0} s",
+                    n * 100 / total.max(1),
+                    l.failed,
+                    l.elapsed_s
+                );
+            }
+        }
         Progress::Bar => {
-            if status == Status::Fail {
+            if fail {
                 let _ = write!(out, "\r\x1b[2K");
-                let _ = writeln!(out, "fail {id}");
                 details(out);
             }
             let width = 30;
             let done = n * width / total.max(1);
             let bar: String = "#".repeat(done) + &"-".repeat(width - done);
-            let short: String = id.chars().take(50).collect();
+            let short: String = l.id.chars().take(50).collect();
             let _ = write!(out, "\r\x1b[2K[{bar}] {n}/{total} {short}");
             let _ = out.flush();
         }
@@ -527,6 +605,7 @@ fn build_report(
         coverage,
         coverage_summary,
         stale_expectations: stale,
+        timing: None,
     }
 }
 

@@ -23,6 +23,19 @@ pub enum SelectError {
         /// Why.
         why: String,
     },
+    /// A `--case` or `--skip` pattern matches no case of the families run.
+    #[error("--{option} {}: matches no case{}", quote(.pattern), did_you_mean(.closest))]
+    NoMatch {
+        /// `case` or `skip`.
+        option: &'static str,
+        /// The pattern.
+        pattern: String,
+        /// The closest case IDs and groups, best first.
+        closest: Vec<String>,
+    },
+    /// The patterns and `--level` leave no case to run.
+    #[error("the selection (--case, --skip, --level) leaves no case to run")]
+    Empty,
     /// The expectations file cannot be read or parsed.
     #[error("expectations file {file}: {why}")]
     Expect {
@@ -31,6 +44,43 @@ pub enum SelectError {
         /// What is wrong.
         why: String,
     },
+}
+
+/// `; did you mean A, B or C?`, or nothing without candidates.
+pub fn did_you_mean(closest: &[String]) -> String {
+    match closest {
+        [] => String::new(),
+        [one] => format!("; did you mean {one}?"),
+        [init @ .., last] => format!("; did you mean {} or {last}?", init.join(", ")),
+    }
+}
+
+/// Similarity (Jaro-Winkler) from which a name counts as close to what was typed.
+const CLOSE: f64 = 0.75;
+
+/// The names of `candidates` closest to `typed` (at most three, best first, each at least
+/// [`CLOSE`] alike); glob characters in `typed` are ignored.
+pub fn closest<'a>(typed: &str, candidates: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+    let typed: String = typed
+        .chars()
+        .filter(|c| !matches!(c, '*' | '?' | '[' | ']' | '{' | '}'))
+        .collect();
+    let mut scored: Vec<(f64, &str)> = candidates
+        .into_iter()
+        .map(|c| (strsim::jaro_winkler(&typed, c), c))
+        .filter(|(score, _)| *score >= CLOSE)
+        .collect();
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| a.1.cmp(b.1)));
+    let mut out: Vec<String> = Vec::new();
+    for (_, c) in scored {
+        if out.len() == 3 {
+            break;
+        }
+        if !out.iter().any(|o| o == c) {
+            out.push(c.to_owned());
+        }
+    }
+    out
 }
 
 /// Longest case pattern: case IDs are well under 100 characters, and a glob's matcher grows
@@ -149,6 +199,32 @@ impl Selection {
                 .collect::<Result<_, _>>()?,
             level,
         })
+    }
+
+    /// Checks that every `--case` and `--skip` pattern matches one of `ids` (the cases of the
+    /// families run); the error of one that does not names the closest IDs and groups.
+    pub fn check_patterns(&self, ids: &[&str]) -> Result<(), SelectError> {
+        let options = [("case", &self.include), ("skip", &self.exclude)];
+        for (option, patterns) in options {
+            for p in patterns {
+                if ids.iter().any(|id| p.matches(id)) {
+                    continue;
+                }
+                let mut names: Vec<&str> = Vec::new();
+                for id in ids {
+                    let ends = id.match_indices('/').map(|(i, _)| i).chain([id.len()]);
+                    names.extend(ends.filter_map(|end| id.get(..end)));
+                }
+                names.sort_unstable();
+                names.dedup();
+                return Err(SelectError::NoMatch {
+                    option,
+                    pattern: p.as_str().to_owned(),
+                    closest: closest(p.as_str(), names),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Whether case `id` of `level` runs.

@@ -87,7 +87,7 @@ pub(crate) struct Found {
 }
 
 /// Limits of a campaign.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct Limits {
     /// Sequences to run (None: until the deadline).
     pub(crate) iterations: Option<u64>,
@@ -97,6 +97,8 @@ pub(crate) struct Limits {
     pub(crate) max_findings: usize,
     /// Runs per minimisation.
     pub(crate) minimize_runs: u64,
+    /// Set by the caller to stop after the current sequence.
+    pub(crate) stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 /// Steps kept since the last fresh start on transports that cannot reset (a restart, or the
@@ -131,6 +133,10 @@ pub(crate) fn campaign(
         }
         if limits.duration.is_some_and(|d| started.elapsed() >= d) {
             stats.stopped_by = "duration".to_owned();
+            break;
+        }
+        if limits.stop.load(std::sync::atomic::Ordering::Relaxed) {
+            stats.stopped_by = "interrupted".to_owned();
             break;
         }
         let seq = target.generate(&mut rng);

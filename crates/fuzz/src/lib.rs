@@ -81,6 +81,9 @@ pub struct Options {
     pub minimize_runs: u64,
     /// The command, for replay lines (`drivespec fuzz`).
     pub command: String,
+    /// Set by the caller to stop after the current sequence; the report is marked
+    /// interrupted.
+    pub stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
 impl Default for Options {
@@ -97,6 +100,7 @@ impl Default for Options {
             max_findings: 20,
             minimize_runs: 400,
             command: "drivespec fuzz".to_owned(),
+            stop: std::sync::Arc::default(),
         }
     }
 }
@@ -343,6 +347,7 @@ fn campaign(
     }
     let family = target.family();
     let mode = opts.progress.resolve();
+    let (started, clock) = (std::time::SystemTime::now(), std::time::Instant::now());
     let mut stats = Stats::new(family, settings.seed);
     let iterations = match (opts.iterations, opts.duration) {
         (None, None) => Some(DEFAULT_ITERATIONS),
@@ -353,6 +358,7 @@ fn campaign(
         duration: opts.duration,
         max_findings: opts.max_findings,
         minimize_runs: opts.minimize_runs,
+        stop: opts.stop.clone(),
     };
     let dut = opts.dut.to_string();
     let mut findings: Vec<Finding> = Vec::new();
@@ -493,7 +499,12 @@ fn campaign(
         model: settings.model.clone(),
         replay_cmd: &replay_cmd,
     };
-    let report = output::build(&desc, &findings, &stats, &|id| target.requirement(id), &all);
+    let mut report = output::build(&desc, &findings, &stats, &|id| target.requirement(id), &all);
+    report.summary.interrupted = stats.stopped_by == "interrupted";
+    report.timing = Some(report::Timing {
+        started,
+        wall_ms: clock.elapsed().as_secs_f64() * 1000.0,
+    });
     let mut written = Vec::new();
     if !opts.no_reports {
         let dir = &opts.out_dir;

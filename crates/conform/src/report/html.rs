@@ -60,6 +60,9 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
         "<table><tr><th>cases</th><th class=\"pass\">pass</th><th class=\"acceptable\">of which acceptable</th><th class=\"fail\">fail</th><th class=\"expected-failure\">expected failures</th><th class=\"fixed\">fixed</th><th class=\"skipped\">skipped</th><th class=\"not-run\">not run</th></tr><tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr></table>",
         s.total, s.passed, s.acceptable, s.failed, s.expected_failures, s.fixed, s.skipped, s.not_run
     );
+    if s.interrupted {
+        h.push_str("<p class=\"fail\">interrupted: the run was stopped before its end; the cases it did not reach are not run</p>\n");
+    }
     for k in &r.stale_expectations {
         let _ = writeln!(
             h,

@@ -1,10 +1,10 @@
-//! JUnit XML in the form GitHub and GitLab test reporters read: `<testsuites>` with one
-//! `<testsuite>` per family and one `<testcase name classname time>` per case; failures
-//! carry `message` and a text with expected vs got, the requirements, the exchange and the
-//! replay command; skipped and known failures are `<skipped>`.
+//! JUnit XML (`drivespec_report::junit`): one `<testsuite>` per family and one `<testcase
+//! name classname time>` per case; a failure carries `message` and a text with the broken
+//! requirement, allowed vs got and the replay command, and the exchange in `<system-out>`;
+//! skipped, not-run and known failures are `<skipped>`.
 
 use super::{CaseReport, Report, Status};
-use drivespec_report::junit::{Case, Document, Form, Outcome, Suite};
+use drivespec_report::junit::{self as xml, Case, Document, Outcome, Problem, Suite};
 use std::fmt::Write as _;
 
 /// The report as JUnit XML.
@@ -27,67 +27,84 @@ pub fn junit_with(r: &Report, tool: &str, properties: &[(String, String)]) -> St
                 ("address".to_owned(), r.run.address.to_string()),
             ];
             props.extend(properties.iter().cloned());
+            if r.summary.interrupted {
+                props.push(("interrupted".to_owned(), "true".to_owned()));
+            }
             Suite {
                 name: family.to_string(),
+                time_ms: match (r.run.families.len(), r.timing) {
+                    (1, Some(t)) => Some(t.wall_ms),
+                    _ => None,
+                },
                 properties: props,
                 cases: r
                     .cases
                     .iter()
                     .filter(|c| c.family == *family)
-                    .map(case)
+                    .map(|c| case(c, r.summary.interrupted))
                     .collect(),
             }
         })
         .collect();
     Document {
         name: tool.to_owned(),
-        form: Form::Timed,
+        timestamp: r.timing.map(|t| xml::timestamp(t.started)),
+        hostname: r.timing.map(|_| xml::hostname()),
         suites,
     }
     .to_xml()
 }
 
-fn case(c: &CaseReport) -> Case {
+fn case(c: &CaseReport, interrupted: bool) -> Case {
     let mut parts = c.id.split('/');
     let classname = match (parts.next(), parts.next()) {
         (Some(f), Some(g)) => format!("{f}.{g}"),
         (Some(f), None) => f.to_owned(),
         _ => String::new(),
     };
+    let mut output = None;
     let outcome = match c.status {
         Status::Pass => Outcome::Passed,
-        Status::Acceptable => Outcome::PassedWithOutput(
-            c.findings
-                .iter()
-                .map(|f| format!("acceptable: {}\n", f.line()))
-                .collect(),
-        ),
-        Status::Fixed => Outcome::PassedWithOutput(format!(
-            "passes although the expectations file lists it as a known failure ({}); remove the entry",
-            c.expectation.as_deref().unwrap_or("")
-        )),
+        Status::Acceptable => {
+            output = Some(
+                c.findings
+                    .iter()
+                    .map(|f| format!("acceptable: {}\n", f.line()))
+                    .collect(),
+            );
+            Outcome::Passed
+        }
+        Status::Fixed => {
+            output = Some(format!(
+                "passes although the expectations file lists it as a known failure ({}); remove the entry",
+                c.expectation.as_deref().unwrap_or("")
+            ));
+            Outcome::Passed
+        }
         Status::ExpectedFailure => Outcome::Skipped(format!(
             "known failure: {}",
             c.expectation.as_deref().unwrap_or("")
         )),
+        Status::NotRun if interrupted => {
+            Outcome::Skipped("not run: the run was interrupted".to_owned())
+        }
         Status::NotRun => Outcome::Skipped("not run: --fail-fast stopped the run".to_owned()),
         Status::Skipped => Outcome::Skipped(c.skip_reason.clone().unwrap_or_default()),
         Status::Fail => {
-            let (message, text) = match &c.failure {
-                Some(f) => (
-                    match f.broken() {
-                        Some(r) => format!("breaks {}: {}", r.id, f.message),
-                        None => f.message.clone(),
-                    },
-                    failure_text(c),
-                ),
-                None => ("failed".to_owned(), String::new()),
+            let message = match &c.failure {
+                Some(f) => match f.broken() {
+                    Some(r) => format!("breaks {}: {}", r.id, f.message),
+                    None => f.message.clone(),
+                },
+                None => "failed".to_owned(),
             };
-            Outcome::Failed {
+            let log = exchange_text(c);
+            output = (!log.is_empty()).then_some(log);
+            Outcome::Failed(Problem {
                 message,
                 kind: "mismatch".to_owned(),
-                text: Some(text),
-            }
+                text: Some(failure_text(c)),
+            })
         }
     };
     Case {
@@ -95,11 +112,13 @@ fn case(c: &CaseReport) -> Case {
         classname,
         time_ms: c.wall_ms,
         outcome,
+        output,
     }
 }
 
-/// The failure text: expected vs got, requirements, the exchange, the replay command.
-pub(crate) fn failure_text(c: &CaseReport) -> String {
+/// The failure text: the broken requirement, allowed vs got, the other requirements cited,
+/// the replay command.
+fn failure_text(c: &CaseReport) -> String {
     let mut t = String::new();
     if let Some(f) = &c.failure {
         for l in f.headline() {
@@ -112,6 +131,15 @@ pub(crate) fn failure_text(c: &CaseReport) -> String {
             }
         }
     }
+    if let Some(r) = &c.replay {
+        let _ = writeln!(t, "replay: {r}");
+    }
+    t
+}
+
+/// The exchange of a case, step by step: what was sent, expected and got.
+fn exchange_text(c: &CaseReport) -> String {
+    let mut t = String::new();
     if !c.evidence.is_empty() {
         t.push_str("exchange:\n");
         for e in &c.evidence {
@@ -142,9 +170,6 @@ pub(crate) fn failure_text(c: &CaseReport) -> String {
                 let _ = writeln!(t, "        note     {n}");
             }
         }
-    }
-    if let Some(r) = &c.replay {
-        let _ = writeln!(t, "replay: {r}");
     }
     t
 }

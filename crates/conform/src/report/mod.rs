@@ -31,7 +31,7 @@ pub enum Status {
     Fixed,
     /// Not run, with a reason (a capability the transport lacks).
     Skipped,
-    /// Not run because `--fail-fast` stopped the run.
+    /// Not run because `--fail-fast` or an interrupt stopped the run.
     NotRun,
 }
 
@@ -69,6 +69,19 @@ pub struct Report {
     pub coverage_summary: Vec<FamilyCoverage>,
     /// Expectations entries that matched no selected case.
     pub stale_expectations: Vec<crate::select::KnownFailure>,
+    /// When the run started and how long it took (JUnit); not in the JSON, which stays the
+    /// same for the same run.
+    #[serde(skip)]
+    pub timing: Option<Timing>,
+}
+
+/// When a run started and how long it took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    /// The start, on the system clock.
+    pub started: std::time::SystemTime,
+    /// Wall time of the whole run (ms).
+    pub wall_ms: f64,
 }
 
 /// Tool name and version.
@@ -122,8 +135,11 @@ pub struct Counts {
     pub fixed: usize,
     /// Skipped with a reason.
     pub skipped: usize,
-    /// Not run (fail-fast).
+    /// Not run (fail-fast or interrupted).
     pub not_run: usize,
+    /// The run was stopped before its end (a signal or the time limit); present only then.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub interrupted: bool,
     /// 0 pass, 1 failures (2 is never written: the run did not happen).
     pub exit_code: u8,
 }
