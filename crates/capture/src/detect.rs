@@ -38,6 +38,9 @@ pub enum Format {
     JsonLines,
     /// IO-Link master log, CSV (IOLINK-LOG.md).
     Csv,
+    /// Text in none of the layouts above (UTF-16 included): not a recording drivespec can
+    /// tell; reading it needs `--format`.
+    UnknownText,
     /// None of the above: raw bytes.
     Raw,
 }
@@ -62,6 +65,7 @@ impl fmt::Display for Format {
             Format::SerialText => f.write_str("serial text"),
             Format::JsonLines => f.write_str("IO-Link JSON lines"),
             Format::Csv => f.write_str("IO-Link CSV"),
+            Format::UnknownText => f.write_str("text in no known layout"),
             Format::Raw => f.write_str("raw bytes"),
         }
     }
@@ -164,8 +168,12 @@ fn classify(prefix: &[u8]) -> (Format, String) {
     text_format(prefix)
 }
 
-/// The complete lines of `prefix` when it is text.
+/// The UTF-8 byte-order mark, which some editors write before the first line (Unicode 3.10).
+pub(crate) const BOM: &[u8] = &[0xef, 0xbb, 0xbf];
+
+/// The complete lines of `prefix` when it is text (after a byte-order mark, if any).
 fn text_lines(prefix: &[u8]) -> Option<Vec<&str>> {
+    let prefix = prefix.strip_prefix(BOM).unwrap_or(prefix);
     let valid = match std::str::from_utf8(prefix) {
         Ok(s) => s,
         Err(e) => {
@@ -199,6 +207,18 @@ fn text_format(prefix: &[u8]) -> (Format, String) {
     if prefix.is_empty() {
         return raw("empty input");
     }
+    if let Some(mark) = [[0xff, 0xfe], [0xfe, 0xff]]
+        .iter()
+        .find(|m| prefix.starts_with(m.as_slice()))
+    {
+        return (
+            Format::UnknownText,
+            format!(
+                "UTF-16 text (byte-order mark {}): convert it to UTF-8",
+                to_hex_lower(mark)
+            ),
+        );
+    }
     let Some(lines) = text_lines(prefix) else {
         return raw("no known magic and not text");
     };
@@ -222,7 +242,10 @@ fn text_format(prefix: &[u8]) -> (Format, String) {
     if crate::serial::parse_text_line(first).is_ok() {
         return (Format::SerialText, format!("serial text line `{shown}`"));
     }
-    raw("text in no known layout")
+    (
+        Format::UnknownText,
+        format!("first line `{shown}` is in none of the text layouts"),
+    )
 }
 
 #[cfg(test)]

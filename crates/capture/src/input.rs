@@ -291,6 +291,9 @@ impl<R: Read> Lines<R> {
         while matches!(buf.last(), Some(b'\n' | b'\r')) {
             buf.pop();
         }
+        if self.line == 1 && buf.starts_with(crate::detect::BOM) {
+            buf.drain(..crate::detect::BOM.len());
+        }
         if buf.len() > self.limit {
             return Some(Err(LineError::TooLong {
                 line: self.line,

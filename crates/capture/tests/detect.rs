@@ -86,8 +86,18 @@ fn samples() -> Vec<(Vec<u8>, Format, &'static str)> {
             Format::Csv,
             "CSV header `time,port,kind,out,in`",
         ),
+        (
+            b"\xef\xbb\xbf{\"kind\":\"pd\",\"out\":\"01\"}\n".to_vec(),
+            Format::JsonLines,
+            "JSON object line",
+        ),
         (vec![0x02, 0x41, 0x01, 0x40, 0x82], Format::Raw, "not text"),
-        (b"hello\n".to_vec(), Format::Raw, "no known layout"),
+        (
+            b"hello\n".to_vec(),
+            Format::UnknownText,
+            "none of the text layouts",
+        ),
+        (vec![0xff, 0xfe, b'{', 0], Format::UnknownText, "UTF-16"),
         (Vec::new(), Format::Raw, "empty input"),
     ]
 }

@@ -251,6 +251,15 @@ fn plan(
         InputFormat::Csv => Plan::Csv,
         InputFormat::Auto => match detected {
             Format::Pcap { .. } | Format::PcapNg { .. } => capture(false)?,
+            Format::UnknownText => {
+                return Err(unreadable(
+                    path,
+                    format!(
+                        "cannot tell what this recording is: {}; give --format",
+                        detection.reason
+                    ),
+                ))
+            }
             Format::Socat | Format::SerialText | Format::Raw => {
                 notes.push("device: hpd (serial recording)".into());
                 Plan::SerialAuto

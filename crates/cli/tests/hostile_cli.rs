@@ -502,3 +502,40 @@ fn an_empty_recording_is_nothing_to_check() {
     );
     assert!(!stdout.contains("PASS"), "{stdout}");
 }
+
+#[test]
+fn a_byte_order_mark_is_read_past_and_unknown_text_is_not_taken_for_hpd_bytes() {
+    let dir = temp_dir("hostile", "text-kinds");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../corpus/captures");
+    let plain = root.join("psx3xx-faults.jsonl");
+    let mut marked = vec![0xef, 0xbb, 0xbf];
+    marked.extend(std::fs::read(&plain).unwrap());
+    let bom = dir.join("bom.jsonl");
+    std::fs::write(&bom, marked).unwrap();
+    let violations = |path: &Path| {
+        let (code, out, err) = run(BIN, &["--format", "json", "check", path.to_str().unwrap()]);
+        assert_eq!(code, 1, "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        v["violation_count"].as_u64().unwrap()
+    };
+    assert_eq!(violations(&bom), violations(&plain));
+
+    for (name, bytes) in [
+        ("notes.txt", b"hello, this is no recording\n".to_vec()),
+        (
+            "utf16.csv",
+            vec![0xff, 0xfe, b't', 0, b'i', 0, b'm', 0, b'e', 0],
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let (code, _, err) = run(BIN, &["check", path.to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains("cannot tell what this recording is"),
+            "{name}: {err}"
+        );
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
