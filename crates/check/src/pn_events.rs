@@ -111,6 +111,13 @@ fn station_name(blocks: &[(u8, u8, &[u8])]) -> Option<String> {
         .map(|n| String::from_utf8_lossy(n).into_owned())
 }
 
+/// Lists an event the standard allows: an allowed state that ends where it begins.
+fn event(rec: &mut Recorder, id: &str, subject: &str, at: Where, message: String, reason: &str) {
+    if let Some(i) = rec.allowed(id, subject, at, message, reason) {
+        rec.ended(i, at);
+    }
+}
+
 impl PnEvents {
     /// Recognisers naming PNIOStatus values and alarm types with `names`.
     pub fn new(names: PnioNames) -> PnEvents {
@@ -159,7 +166,7 @@ impl PnEvents {
                     self.names.status(s)
                 );
                 if closed {
-                    rec.allowed("PN-ALARM-002", &subj, f.at, message, CLOSING_REASON);
+                    event(rec, "PN-ALARM-002", &subj, f.at, message, CLOSING_REASON);
                 } else {
                     rec.violation(
                         "PN-ALARM-002",
@@ -181,7 +188,8 @@ impl PnEvents {
                     return;
                 }
                 let priority = if block == 0x0001 { "high" } else { "low" };
-                rec.allowed(
+                event(
+                    rec,
                     "PN-ALARM-001",
                     &subj,
                     f.at,
