@@ -21,8 +21,10 @@ use drivespec_spec::Spec;
 const T0: u64 = 1_700_000_000_000_000;
 const OTHER_MAC: [u8; 6] = [0x00, 0x1b, 0x1b, 0x0d, 0x0e, 0x0f];
 
-/// Frames as (time µs after T0, destination, source, RT payload with FrameID).
-fn capture(frames: &[(u64, [u8; 6], [u8; 6], Vec<u8>)]) -> Vec<u8> {
+/// A frame: time µs after T0, destination, source, RT payload with FrameID.
+type Frame = (u64, [u8; 6], [u8; 6], Vec<u8>);
+
+fn capture(frames: &[Frame]) -> Vec<u8> {
     let mut w = PcapWriter::new(Vec::new(), LinkType::ETHERNET, 65535).unwrap();
     for (t, dst, src, payload) in frames {
         w.write_packet(T0 + t, &ethernet(*dst, *src, 0x8892, payload))
