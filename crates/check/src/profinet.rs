@@ -6,8 +6,9 @@
 //! [`check`] is a pure function over `drivespec_capture::profinet::PnEvent`s (style rule
 //! 12); [`PnChecker`] is the same as a push API. Memory is bounded whatever the capture size:
 //! at most [`MAX_STREAMS`] streams, [`MAX_ARS`] application relations,
-//! [`SEARCH_FRAMES`] buffered frames for the search and one C_SDU per stream to watch for
-//! changes between search batches; everything else is per stream or per drive. Nothing here
+//! [`SEARCH_FRAMES`] buffered frames for the search, one C_SDU per stream to watch for
+//! changes between search batches, [`MAX_STREAMS`] pairs of stations that ended an AR and
+//! the bounded state of [`crate::pn_events`]; everything else is per stream or per drive. Nothing here
 //! panics.
 //!
 //! Conditions are reported when they start (a transition), not on every frame: a provider
@@ -570,7 +571,7 @@ impl<'s> PnChecker<'s> {
                 };
                 if h.pdu_type & 0x0f == 4 {
                     if let Some(t) = o.time {
-                        self.ended.insert(pair(src, dst), t);
+                        self.end_ar(src, dst, t);
                     }
                 }
                 self.pn_events.alarm(&mut self.rec, &f, &h, ar, closed);
@@ -905,6 +906,15 @@ impl<'s> PnChecker<'s> {
         }
     }
 
+    /// Notes that the stations `a` and `b` released or aborted their AR at `t` (at most
+    /// [`MAX_STREAMS`] pairs are remembered).
+    fn end_ar(&mut self, a: [u8; 6], b: [u8; 6], t: u64) {
+        let k = pair(a, b);
+        if self.ended.len() < MAX_STREAMS || self.ended.contains_key(&k) {
+            self.ended.insert(k, t);
+        }
+    }
+
     /// The latest AR between two stations (either initiator), in words, and the time of
     /// its Connect.
     fn ar_between(&self, a: [u8; 6], b: [u8; 6]) -> Option<(String, Option<u64>)> {
@@ -1010,7 +1020,7 @@ impl<'s> PnChecker<'s> {
                                 .report()
                                 .note(format!("AR {} released at {at}", c.ar_uuid));
                             if let (Some(a), Some(b), Some(t)) = (ev.src, ev.dst, ev.time) {
-                                self.ended.insert(pair(a, b), t);
+                                self.end_ar(a, b, t);
                             }
                         }
                     }
