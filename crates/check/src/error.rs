@@ -2,6 +2,7 @@
 //! (Problems of the checked traffic are violations, and read errors end up in
 //! [`crate::Report::error`]; neither is an error here.)
 
+use crate::pnio_names::NamesError;
 use crate::report::CatalogError;
 
 /// A checker cannot be set up (style rule 8: errors carry data).
@@ -11,6 +12,9 @@ pub enum SetupError {
     /// The requirement catalogue (generic PROFINET rules) is broken.
     #[error(transparent)]
     Catalog(#[from] CatalogError),
+    /// The PNIOStatus and AlarmType names are unusable.
+    #[error(transparent)]
+    Names(#[from] NamesError),
     /// The HPD tables of the spec are unusable (manual 4.1).
     #[error("HPD rules: {0}")]
     Hpd(#[from] drivespec_hpd::RulesError),

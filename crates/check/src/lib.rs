@@ -15,6 +15,8 @@ pub mod error;
 pub mod hpd;
 pub mod iolink;
 pub mod locate;
+pub mod pn_events;
+pub mod pnio_names;
 pub mod profinet;
 pub mod psd4xx;
 pub mod render;

@@ -6,8 +6,9 @@
 //! [`check`] is a pure function over `drivespec_capture::profinet::PnEvent`s (style rule
 //! 12); [`PnChecker`] is the same as a push API. Memory is bounded whatever the capture size:
 //! at most [`MAX_STREAMS`] streams, [`MAX_ARS`] application relations,
-//! [`SEARCH_FRAMES`] buffered frames for the search and one C_SDU per stream to watch for
-//! changes between search batches; everything else is per stream or per drive. Nothing here
+//! [`SEARCH_FRAMES`] buffered frames for the search, one C_SDU per stream to watch for
+//! changes between search batches, [`MAX_STREAMS`] pairs of stations that ended an AR and
+//! the bounded state of [`crate::pn_events`]; everything else is per stream or per drive. Nothing here
 //! panics.
 //!
 //! Conditions are reported when they start (a transition), not on every frame: a provider
@@ -17,6 +18,8 @@
 
 use crate::error::SetupError;
 use crate::locate::{self, Binding, Buffered, StreamKey};
+use crate::pn_events::{mac, Frame, PnEvents};
+use crate::pnio_names::PnioNames;
 use crate::psd4xx::{PsdDrive, PsdOptions};
 use crate::report::{
     Catalog, DriveInfo, Evidence, InputFault, Policy, Recorder, Report, Stats, StreamStats, Where,
@@ -28,10 +31,9 @@ use drivespec_capture::pnio::{
     Block, CmMessage, ControlKind, Direction, IocrBlockReq, Operation, PnioStatus,
 };
 use drivespec_capture::profinet::{Counts, MalformedError, Pdu, PduError, PnEvent, PnEventKind};
-use drivespec_capture::rt::{ApduStatus, FrameClass, RtError};
+use drivespec_capture::rt::{ApduStatus, FrameClass, RtError, RtFrame};
 use drivespec_psd4xx::model::{Drive, DriveConfig};
 use drivespec_psd4xx::{Input, Output, Rules};
-use drivespec_spec::hex::{encode, Case};
 use drivespec_spec::{FamilyId, Spec};
 use serde_json::json;
 use std::collections::{BTreeMap, HashMap, VecDeque};
@@ -52,11 +54,25 @@ const STARTUP_STOP: &str = "start-up: a provider reports STOP (DataStatus.Provid
 /// Why a bad IOPS of a provider in STOP is no violation of PN-IO-IOPS-001.
 const BAD_IN_STOP: &str = "a provider in STOP marks its data bad (IOPS = Bad: CPU in \"Stop\" state, bus description 3.9; IEC 61158-6-10 IOxS)";
 
+/// Send intervals without a frame after which a stream with no Connect counts as stopped
+/// (the least DataHoldFactor, IEC 61158-6-10 IOCRBlockReq).
+const STOP_CYCLES: u64 = 3;
+
+/// Capture time (µs) after a Connect request without which its missing answer is not
+/// reported (the capture may end before the device could answer).
+const CONNECT_ANSWER_US: u64 = 1_000_000;
+
 /// µs per cycle counter unit (IEC 61158-6-10: 31.25 µs).
 const COUNT_NS: u64 = 31_250;
 
 /// The generic requirements checked on every capture.
 const CHECKED: &[&str] = &[
+    "PN-ALARM-002",
+    "PN-AR-001",
+    "PN-CM-003",
+    "PN-DCP-001",
+    "PN-DCP-002",
+    "PN-DCP-003",
     "PN-RT-CC-001",
     "PN-RT-CC-002",
     "PN-RT-CC-003",
@@ -177,6 +193,8 @@ struct Ar {
     responder: Option<[u8; 6]>,
     request: CmMessage,
     response: Option<CmMessage>,
+    /// A Connect response (accepting or refusing) was seen.
+    answered: bool,
     applied: bool,
     at: Where,
 }
@@ -238,6 +256,12 @@ pub struct PnChecker<'s> {
     cyclic_frames: u64,
     connects_without_psd: u64,
     first_without_psd: Option<Where>,
+    /// Alarms, DCP conflicts and Sets.
+    pn_events: PnEvents,
+    /// The latest capture time seen.
+    last_time: Option<u64>,
+    /// When the stations of an AR (either order) last released or aborted it.
+    ended: HashMap<([u8; 6], [u8; 6]), u64>,
 }
 
 /// A fast hasher for stream keys (FxHash's multiply-rotate; keys come from the capture, and
@@ -272,10 +296,6 @@ impl std::hash::BuildHasher for BuildFx {
     fn build_hasher(&self) -> Fx {
         Fx::default()
     }
-}
-
-fn mac(m: &[u8; 6]) -> String {
-    encode(m, Case::Lower, ":")
 }
 
 impl<'s> PnChecker<'s> {
@@ -346,6 +366,9 @@ impl<'s> PnChecker<'s> {
             cyclic_frames: 0,
             connects_without_psd: 0,
             first_without_psd: None,
+            pn_events: PnEvents::new(PnioNames::load()?),
+            last_time: None,
+            ended: HashMap::new(),
             options,
         };
         if let Some(m) = c.options.manual {
@@ -458,13 +481,20 @@ impl<'s> PnChecker<'s> {
             src: ev.src,
             dst: ev.dst,
         };
+        self.saw_time(ev.time);
         match &ev.kind {
             PnEventKind::Cyclic {
                 frame_id,
                 data,
                 apdu,
             } => self.push_cyclic(&o, frame_id.0, data, *apdu),
-            PnEventKind::Acyclic { class, .. } => self.push_acyclic(&o, *class),
+            PnEventKind::Acyclic { frame_id, body, .. } => self.push_acyclic(
+                &o,
+                &RtFrame {
+                    frame_id: *frame_id,
+                    body,
+                },
+            ),
             PnEventKind::Cm {
                 message, header, ..
             } => self.push_cm(&o, header.activity, message),
@@ -490,10 +520,11 @@ impl<'s> PnChecker<'s> {
             src,
             dst,
         };
+        self.saw_time(time);
         match pdu {
             Ok(Pdu::Rt { frame, .. }) => match frame.cyclic() {
                 Ok(c) => self.push_cyclic(&o, c.frame_id.0, c.data, c.apdu),
-                Err(RtError::WrongClass { .. }) => self.push_acyclic(&o, frame.class()),
+                Err(RtError::WrongClass { .. }) => self.push_acyclic(&o, frame),
                 Err(e) => self.push_malformed(&o, &MalformedError::Frame(PduError::Rt(e))),
             },
             Ok(Pdu::Rpc {
@@ -517,7 +548,38 @@ impl<'s> PnChecker<'s> {
         self.events += 1;
     }
 
-    fn push_acyclic(&mut self, _o: &Origin, class: FrameClass) {
+    fn saw_time(&mut self, time: Option<u64>) {
+        if let Some(t) = time {
+            self.last_time = Some(self.last_time.map_or(t, |l| l.max(t)));
+        }
+    }
+
+    fn push_acyclic(&mut self, o: &Origin, frame: &RtFrame<'_>) {
+        let class = frame.class();
+        if let (Some(src), Some(dst)) = (o.src, o.dst) {
+            let f = Frame {
+                at: self.at(o),
+                src,
+                dst,
+            };
+            if let Ok(h) = frame.alarm() {
+                let (ar, since) = self.ar_between(src, dst).unzip();
+                let closed = match (self.ended.get(&pair(src, dst)), since.flatten()) {
+                    (Some(e), Some(c)) => *e >= c,
+                    (Some(_), None) => true,
+                    (None, _) => false,
+                };
+                if h.pdu_type & 0x0f == 4 {
+                    if let Some(t) = o.time {
+                        self.end_ar(src, dst, t);
+                    }
+                }
+                self.pn_events.alarm(&mut self.rec, &f, &h, ar, closed);
+            } else if let Ok(h) = frame.dcp() {
+                let ar = self.running_ar_of(dst, o.time);
+                self.pn_events.dcp(&mut self.rec, &f, &h, ar);
+            }
+        }
         let kind = if class.is_dcp() {
             "dcp"
         } else if class.is_ptcp() {
@@ -844,6 +906,46 @@ impl<'s> PnChecker<'s> {
         }
     }
 
+    /// Notes that the stations `a` and `b` released or aborted their AR at `t` (at most
+    /// [`MAX_STREAMS`] pairs are remembered).
+    fn end_ar(&mut self, a: [u8; 6], b: [u8; 6], t: u64) {
+        let k = pair(a, b);
+        if self.ended.len() < MAX_STREAMS || self.ended.contains_key(&k) {
+            self.ended.insert(k, t);
+        }
+    }
+
+    /// The latest AR between two stations (either initiator), in words, and the time of
+    /// its Connect.
+    fn ar_between(&self, a: [u8; 6], b: [u8; 6]) -> Option<(String, Option<u64>)> {
+        self.ars
+            .iter()
+            .rev()
+            .find(|x| {
+                x.responder
+                    .is_some_and(|r| pair(x.initiator, r) == pair(a, b))
+            })
+            .map(|x| (format!("AR {}, Connect at {}", x.ar_uuid, x.at), x.at.time))
+    }
+
+    /// The AR whose IO device is `device`, established and neither released nor aborted
+    /// by `now`, in words.
+    fn running_ar_of(&self, device: [u8; 6], now: Option<u64>) -> Option<String> {
+        self.ars
+            .iter()
+            .rev()
+            .find(|x| {
+                x.applied
+                    && x.responder == Some(device)
+                    && match (self.ended.get(&pair(x.initiator, device)), x.at.time, now) {
+                        (Some(e), Some(start), Some(n)) => *e < start || *e > n,
+                        (Some(_), _, _) => false,
+                        (None, _, _) => true,
+                    }
+            })
+            .map(|x| format!("AR {}, Connect at {}", x.ar_uuid, x.at))
+    }
+
     /// The Connect's IOCR for a stream, if one describes it.
     fn iocr_for(&self, key: &StreamKey) -> Option<IocrInfo> {
         self.iocrs
@@ -874,6 +976,7 @@ impl<'s> PnChecker<'s> {
                     responder: None,
                     request: m.clone(),
                     response: None,
+                    answered: false,
                     applied: false,
                     at,
                 });
@@ -882,6 +985,9 @@ impl<'s> PnChecker<'s> {
                 }
             }
             (Operation::Connect, Direction::Response) => {
+                if let Some(a) = self.ars.iter_mut().find(|a| a.activity == activity) {
+                    a.answered = true;
+                }
                 if let Some(s) = m.ndr.status.filter(|s| !s.is_ok()) {
                     self.cm_failed(ev, "Connect", s);
                     return;
@@ -913,11 +1019,32 @@ impl<'s> PnChecker<'s> {
                             self.rec
                                 .report()
                                 .note(format!("AR {} released at {at}", c.ar_uuid));
+                            if let (Some(a), Some(b), Some(t)) = (ev.src, ev.dst, ev.time) {
+                                self.end_ar(a, b, t);
+                            }
                         }
                     }
                 }
             }
-            (Operation::Read | Operation::Write | Operation::ReadImplicit, _) => {
+            (Operation::Read | Operation::Write | Operation::ReadImplicit, d) => {
+                if d == Direction::Response {
+                    let bad = m.ndr.status.filter(|s| !s.is_ok()).or_else(|| {
+                        m.blocks.iter().find_map(|b| match b {
+                            Block::ReadRes(r) | Block::WriteRes(r) => {
+                                r.status.filter(|s| !s.is_ok())
+                            }
+                            _ => None,
+                        })
+                    });
+                    if let Some(s) = bad {
+                        let what = if m.operation == Operation::Write {
+                            "Write"
+                        } else {
+                            "Read"
+                        };
+                        self.cm_failed(ev, what, s);
+                    }
+                }
                 self.record(ev, m);
             }
             _ => {}
@@ -930,19 +1057,12 @@ impl<'s> PnChecker<'s> {
             (Some(a), Some(b)) => format!("{} → {}", mac(&a), mac(&b)),
             _ => "PNIO-CM".into(),
         };
-        let decode = match s.decode {
-            0x80 => " (PNIORW)",
-            0x81 => " (PNIO)",
-            _ => "",
-        };
+        let words = self.pn_events.status(s);
         self.rec.violation(
             "PN-CM-002",
             &subject,
             at,
-            format!(
-                "{what} answered with PNIOStatus {s}: ErrorCode {:#04x}, ErrorDecode {:#04x}{decode}, ErrorCode1 {:#04x}, ErrorCode2 {:#04x}",
-                s.code, s.decode, s.code1, s.code2
-            ),
+            format!("{what} answered with PNIOStatus {s}: {words}"),
             Evidence::none().with("pnio_status", s.to_string()),
         );
     }
@@ -1228,6 +1348,86 @@ impl<'s> PnChecker<'s> {
         })
     }
 
+    /// Streams whose last frame is followed by more than their watchdog time of capture
+    /// (from the Connect, else [`STOP_CYCLES`] send intervals) with no Release or abort
+    /// of their stations: a connection abort (PN-AR-001).
+    fn stopped_streams(&mut self, end: Option<u64>) {
+        let Some(end) = end else {
+            return;
+        };
+        for (key, s) in &self.streams {
+            let Some((_, last, w)) = s.last else {
+                continue;
+            };
+            if w.time.is_none() {
+                continue;
+            }
+            let (bound, why) = match s.info.as_ref().and_then(|i| i.watchdog_us) {
+                Some(b) => (b, "watchdog time from the Connect"),
+                None => match s.increment {
+                    Some(i) => (
+                        u64::from(i) * COUNT_NS / 1000 * STOP_CYCLES,
+                        "no Connect seen: 3 send intervals, the least DataHoldFactor",
+                    ),
+                    None => continue,
+                },
+            };
+            let gap = end.saturating_sub(last);
+            if gap <= bound {
+                continue;
+            }
+            let released = self
+                .ended
+                .get(&pair(key.1, key.2))
+                .is_some_and(|t| *t <= last.saturating_add(bound));
+            if released {
+                continue;
+            }
+            self.rec.violation(
+                "PN-AR-001",
+                &s.label,
+                w,
+                format!(
+                    "cyclic stream stops: no frame for {} ms after this one while the capture goes on (bound {} ms, {why}); no Release or abort of these stations was seen",
+                    gap / 1000,
+                    bound.div_ceil(1000)
+                ),
+                Evidence::none().with("gap_us", gap).with("bound_us", bound),
+            );
+        }
+    }
+
+    /// Connect requests with no answer and at least [`CONNECT_ANSWER_US`] of capture after
+    /// them (PN-CM-003).
+    fn unanswered_connects(&mut self, end: Option<u64>) {
+        let Some(end) = end else {
+            return;
+        };
+        let open: Vec<(Uuid, [u8; 6], Where)> = self
+            .ars
+            .iter()
+            .filter(|a| {
+                !a.answered
+                    && a.at
+                        .time
+                        .is_some_and(|t| end.saturating_sub(t) >= CONNECT_ANSWER_US)
+            })
+            .map(|a| (a.ar_uuid, a.initiator, a.at))
+            .collect();
+        for (uuid, initiator, at) in open {
+            self.rec.violation(
+                "PN-CM-003",
+                &mac(&initiator),
+                at,
+                format!(
+                    "Connect for AR {uuid} not answered in the {} s of capture after it",
+                    CONNECT_ANSWER_US / 1_000_000
+                ),
+                Evidence::none(),
+            );
+        }
+    }
+
     /// Records that reading stopped with `error`; what was read is still checked.
     pub fn fail(&mut self, error: &CaptureError) {
         let offset = match error {
@@ -1276,6 +1476,10 @@ impl<'s> PnChecker<'s> {
                 self.rec.report().note(note);
             }
         }
+        let end = self.last_time;
+        self.pn_events.finish(&mut self.rec, end);
+        self.stopped_streams(end);
+        self.unanswered_connects(end);
         let mut streams: Vec<(StreamKey, Stream)> = std::mem::take(&mut self.streams);
         streams.sort_by_key(|(k, _)| *k);
         let drives = std::mem::take(&mut self.drives);
@@ -1326,6 +1530,15 @@ impl<'s> PnChecker<'s> {
         r.scope("PSD4xx", Some("psd4xx"), why_not);
         r.judge(Policy::default());
         self.rec.finish()
+    }
+}
+
+/// A pair of stations in a fixed order.
+fn pair(a: [u8; 6], b: [u8; 6]) -> ([u8; 6], [u8; 6]) {
+    if a <= b {
+        (a, b)
+    } else {
+        (b, a)
     }
 }
 

@@ -229,6 +229,7 @@ fn observations(o: &mut String, title: &str, list: &[Observation], count: u64, s
     for x in list {
         let span = match (&x.end, x.duration_us, spans) {
             (_, _, false) => x.start.to_string(),
+            (Some(e), _, true) if *e == x.start => x.start.to_string(),
             (Some(e), Some(d), true) => format!("{} to {e} ({})", x.start, duration(d)),
             (Some(e), None, true) => format!("{} to {e}", x.start),
             (None, _, true) => format!("{} to the end of the capture", x.start),

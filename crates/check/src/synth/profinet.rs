@@ -318,7 +318,7 @@ pub enum PsdFault {
     WriteEchoWrong,
     /// A PKW read of a 32-bit parameter answered with the 16-bit response code.
     WrongResponseCode,
-    /// A record write of a 16-bit parameter 4 bytes long.
+    /// A record write of a 16-bit parameter 4 bytes long, refused by the drive.
     RecordWriteLength,
     /// A record read of a 16-bit parameter answered with 3 bytes.
     RecordReadLength,
@@ -356,7 +356,7 @@ impl PsdFault {
             PsdFault::ReservedControlBit => &[("PSD-CTL-3-001", 1)],
             PsdFault::WriteEchoWrong => &[("PSD-PKW-034", 1)],
             PsdFault::WrongResponseCode => &[("PSD-PKW-012", 1)],
-            PsdFault::RecordWriteLength => &[("PSD-REC-006", 1)],
+            PsdFault::RecordWriteLength => &[("PN-CM-002", 1), ("PSD-REC-006", 1)],
             PsdFault::RecordReadLength => &[("PSD-REC-008", 1)],
             PsdFault::CycleCounterOff => &[("PN-RT-CC-001", 2)],
             PsdFault::DataInvalid => &[("PN-RT-DS-001", 1)],
