@@ -15,6 +15,7 @@ pub mod error;
 pub mod hpd;
 pub mod iolink;
 pub mod locate;
+pub mod ndjson;
 pub mod profinet;
 pub mod psd4xx;
 pub mod render;
