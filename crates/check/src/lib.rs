@@ -15,6 +15,7 @@ pub mod error;
 pub mod hpd;
 pub mod iolink;
 pub mod locate;
+pub mod ndjson;
 pub mod pn_events;
 pub mod pnio_names;
 pub mod profinet;

@@ -26,7 +26,7 @@ pub struct Document<'a> {
     pub failed: u64,
     /// Files whose reading stopped early.
     pub unreadable: u64,
-    /// One report per file, in the order given.
+    /// One report per file, in the order checked (`drivespec check` sorts by path).
     pub reports: &'a [Report],
 }
 

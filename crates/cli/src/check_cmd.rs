@@ -1,23 +1,47 @@
-//! `drivespec check`: recorded traffic against the spec. Parsing, progress and
-//! printing only; the work is in `drivespec_check`.
+//! `drivespec check`: recorded traffic against the spec. Parsing, the list of files, running
+//! them on a thread pool, progress and printing; the work is in `drivespec_check`.
+//!
+//! Files are checked in parallel and reported in path order whatever the timing: results
+//! are printed (text, NDJSON) as soon as every file before them is done, and a file starts
+//! only while fewer than [`WINDOW_PER_JOB`] × jobs files wait to be printed, so memory does
+//! not grow with the number of files.
 
 use crate::interrupt::Interrupt;
 use crate::{Context, Format, Outcome};
 use anyhow::{anyhow, bail, Context as _, Result};
 use drivespec_check::profinet::Manual;
 use drivespec_check::run::{check_path, Device, InputFormat, Progress, RunOptions};
-use drivespec_check::{render, Policy, Report};
+use drivespec_check::{ndjson, render, Policy, Report};
 use drivespec_spec::hex::parse_int;
+use drivespec_spec::Spec;
+use rayon::iter::{ParallelBridge, ParallelIterator};
+use std::collections::BTreeMap;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Condvar, Mutex};
+
+/// Files finished but not yet printed, at most, per job.
+const WINDOW_PER_JOB: usize = 4;
+
+/// File name endings of recordings taken from a folder (after an optional `.gz`).
+const RECORDING_EXTENSIONS: [&str; 10] = [
+    "pcap", "pcapng", "cap", "raw", "bin", "socat", "txt", "log", "jsonl", "csv",
+];
 
 /// Arguments of `drivespec check`.
 #[derive(clap::Args)]
 pub struct CheckArgs {
     /// Recordings to check: pcap/pcapng (PROFINET or serial link types), raw serial bytes,
-    /// socat dumps, serial text, IO-Link JSON lines or CSV; gzip-compressed or not.
-    #[arg(required = true, value_name = "FILE")]
+    /// socat dumps, serial text, IO-Link JSON lines or CSV; gzip-compressed or not. A folder
+    /// stands for the recordings in it and its subfolders (.pcap, .pcapng, .cap, .raw, .bin,
+    /// .socat, .txt, .log, .jsonl, .csv, each also with .gz); files are reported sorted by
+    /// path.
+    #[arg(required = true, value_name = "FILE|DIR")]
     files: Vec<PathBuf>,
+    /// Files checked at the same time (default: the number of cores).
+    #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    jobs: Option<u16>,
     /// Device family (detected from the recording when not given).
     #[arg(long, value_enum)]
     device: Option<DeviceArg>,
@@ -104,6 +128,9 @@ pub enum ReportArg {
     Junit,
     /// HTML with timeline plots.
     Html,
+    /// One JSON object per finding and line, schema drivespec-check-finding/1, and a summary
+    /// line.
+    Ndjson,
 }
 
 fn number(text: &str) -> Result<u64> {
@@ -243,6 +270,184 @@ fn write_reports(dir: &Path, reports: &[Report]) -> Result<()> {
     Ok(())
 }
 
+/// Whether a file found in a folder is a recording, by its name.
+fn is_recording(path: &Path) -> bool {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    name.rsplit_once('.')
+        .is_some_and(|(_, ext)| RECORDING_EXTENSIONS.contains(&ext))
+}
+
+/// Adds the recordings under `dir` (subfolders too; symbolic links to folders are not
+/// followed) to `out`; folders that cannot be listed go to `errors`.
+fn walk(dir: &Path, out: &mut Vec<PathBuf>, errors: &mut Vec<String>) {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) => {
+            errors.push(format!("cannot read folder {}: {e}", dir.display()));
+            return;
+        }
+    };
+    for entry in entries {
+        match entry {
+            Ok(e) => {
+                let path = e.path();
+                if e.file_type().is_ok_and(|t| t.is_dir()) {
+                    walk(&path, out, errors);
+                } else if is_recording(&path) {
+                    out.push(path);
+                }
+            }
+            Err(e) => errors.push(format!("cannot read folder {}: {e}", dir.display())),
+        }
+    }
+}
+
+/// The files to check, sorted by path: files as given, folders expanded.
+fn expand(args: &[PathBuf], errors: &mut Vec<String>) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for a in args {
+        if a.is_dir() {
+            let before = files.len() + errors.len();
+            walk(a, &mut files, errors);
+            if files.len() + errors.len() == before {
+                errors.push(format!("{}: no recordings in this folder", a.display()));
+            }
+        } else {
+            files.push(a.clone());
+        }
+    }
+    files.sort();
+    files.dedup();
+    files
+}
+
+/// What printing needs of each file as it finishes, in path order.
+struct Sink {
+    format: ReportArg,
+    /// Reports kept for the formats written at the end (JSON, JUnit, HTML, `--report-dir`).
+    kept: Vec<Report>,
+    keep: bool,
+    /// Timelines are kept only for the HTML page.
+    timelines: bool,
+    summary: ndjson::Summary,
+    passed: bool,
+    failed: u64,
+    errors: Vec<String>,
+}
+
+impl Sink {
+    fn new(format: ReportArg, report_dir: bool) -> Sink {
+        Sink {
+            format,
+            kept: Vec::new(),
+            keep: report_dir || !matches!(format, ReportArg::Text | ReportArg::Ndjson),
+            timelines: report_dir || format == ReportArg::Html,
+            summary: ndjson::Summary::new(),
+            passed: true,
+            failed: 0,
+            errors: Vec::new(),
+        }
+    }
+
+    /// Prints or keeps one file's result.
+    fn take(&mut self, file: &Path, result: Result<Report, String>) -> Result<()> {
+        let mut r = match result {
+            Ok(r) => r,
+            Err(message) => {
+                if self.format == ReportArg::Ndjson {
+                    let name = file.display().to_string();
+                    say_raw!("{}", self.summary.unreadable_line(&name, &message))?;
+                }
+                self.errors.push(message);
+                return Ok(());
+            }
+        };
+        if let Some(e) = &r.error {
+            self.errors
+                .push(format!("{}: {}", file.display(), e.message));
+        }
+        self.passed &= r.passed();
+        self.failed += u64::from(r.verdict == drivespec_check::Verdict::Fail);
+        match self.format {
+            ReportArg::Text => say_raw!("{}", render::text(std::slice::from_ref(&r)))?,
+            ReportArg::Ndjson => say_raw!("{}", self.summary.report_lines(&r))?,
+            _ => {}
+        }
+        if self.keep {
+            if !self.timelines {
+                r.timelines = Vec::new();
+            }
+            self.kept.push(r);
+        }
+        Ok(())
+    }
+
+    /// Prints what is printed at the end: the documents of the whole run, or the summary.
+    fn finish(&self, files: usize) -> Result<()> {
+        match self.format {
+            ReportArg::Text if files > 1 => say_raw!(
+                "{files} files: {} failed, {} unreadable\n",
+                self.failed,
+                self.errors.len()
+            )?,
+            ReportArg::Text => {}
+            ReportArg::Ndjson => say_raw!("{}", self.summary.line())?,
+            ReportArg::Json => say_raw!("{}", render::json(&self.kept))?,
+            ReportArg::Junit => say_raw!("{}", render::junit(&self.kept))?,
+            ReportArg::Html => say_raw!("{}", render::html(&self.kept))?,
+        }
+        Ok(())
+    }
+}
+
+/// Checks one file; an error names the file.
+fn check_one(
+    spec: &Spec,
+    file: &Path,
+    options: &RunOptions,
+    mut bar: Option<Bar>,
+) -> Result<Report, String> {
+    check_path(spec, file, options, &mut |p| {
+        if let Some(b) = bar.as_mut() {
+            b.show(p);
+        }
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// Files released to the workers: a file starts only while fewer than `window` files wait
+/// to be printed.
+struct Gate {
+    printed: Mutex<usize>,
+    moved: Condvar,
+    window: usize,
+}
+
+impl Gate {
+    /// Waits until file `index` may start.
+    fn enter(&self, index: usize) {
+        let mut printed = self.printed.lock().unwrap_or_else(|e| e.into_inner());
+        while index >= *printed + self.window {
+            printed = self.moved.wait(printed).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+
+    /// Records that files before `next` are printed.
+    fn advance(&self, next: usize) {
+        *self.printed.lock().unwrap_or_else(|e| e.into_inner()) = next;
+        self.moved.notify_all();
+    }
+
+    /// Lets every file start (printing stopped).
+    fn open(&self) {
+        self.advance(usize::MAX / 2);
+    }
+}
+
 /// Runs `drivespec check`.
 pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
     let spec = ctx.spec()?;
@@ -253,48 +458,79 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
         Format::Json => ReportArg::Json,
         _ => ReportArg::Text,
     });
+    let jobs = args.jobs.map_or_else(
+        || std::thread::available_parallelism().map_or(1, usize::from),
+        usize::from,
+    );
+    let mut sink = Sink::new(format, args.report_dir.is_some());
+    let files = expand(&args.files, &mut sink.errors);
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");
-    let tty = std::io::stderr().is_terminal();
-    let mut reports = Vec::new();
-    let mut errors = Vec::new();
-    for file in &args.files {
-        if interrupt.stopped() {
-            break;
-        }
-        let mut bar = Bar {
-            ci,
-            tty,
-            name: file.display().to_string(),
-            last: 0,
-        };
-        match check_path(&spec, file, &options, &mut |p| bar.show(p)) {
-            Ok(r) => {
-                if let Some(e) = &r.error {
-                    errors.push(format!("{}: {}", file.display(), e.message));
-                }
-                reports.push(r);
-            }
-            Err(e) => errors.push(e.to_string()),
-        }
-    }
-    let out = match format {
-        ReportArg::Text => render::text(&reports),
-        ReportArg::Json => render::json(&reports),
-        ReportArg::Junit => render::junit(&reports),
-        ReportArg::Html => render::html(&reports),
+    // A bar redrawn by several files at once would be unreadable: bars only one at a time.
+    let tty = std::io::stderr().is_terminal() && (jobs == 1 || files.len() == 1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .context("cannot start the worker threads")?;
+    let gate = Gate {
+        printed: Mutex::new(0),
+        moved: Condvar::new(),
+        window: jobs.saturating_mul(WINDOW_PER_JOB),
     };
-    say_raw!("{out}")?;
+    let stop = AtomicBool::new(false);
+    let (tx, rx) = mpsc::channel::<(usize, Result<Report, String>)>();
+    let printed = std::thread::scope(|s| {
+        let (spec, options, files, gate, stop) = (&spec, &options, &files, &gate, &stop);
+        s.spawn(move || {
+            pool.install(|| {
+                files
+                    .iter()
+                    .enumerate()
+                    .par_bridge()
+                    .for_each_with(tx, |tx, (i, file)| {
+                        gate.enter(i);
+                        if stop.load(Ordering::Relaxed) || options.stop.load(Ordering::Relaxed) {
+                            return;
+                        }
+                        let bar = (ci || tty).then(|| Bar {
+                            ci,
+                            tty,
+                            name: file.display().to_string(),
+                            last: 0,
+                        });
+                        let _ = tx.send((i, check_one(spec, file, options, bar)));
+                    });
+            });
+        });
+        let mut waiting = BTreeMap::new();
+        let mut next = 0usize;
+        for (i, result) in rx {
+            waiting.insert(i, result);
+            while let Some(result) = waiting.remove(&next) {
+                let file = files.get(next).map_or(Path::new("-"), PathBuf::as_path);
+                if let Err(e) = sink.take(file, result) {
+                    stop.store(true, Ordering::Relaxed);
+                    gate.open();
+                    return Err(e);
+                }
+                next += 1;
+                gate.advance(next);
+            }
+        }
+        Ok(())
+    });
+    printed?;
+    sink.finish(files.len())?;
     if let Some(dir) = &args.report_dir {
-        write_reports(dir, &reports)?;
+        write_reports(dir, &sink.kept)?;
     }
     if let (Some(code), Some(cause)) = (interrupt.exit_code(), interrupt.cause()) {
         eprintln!("drivespec: interrupted by {cause}: the report covers what was read");
         return Ok(Outcome::Stopped(code));
     }
-    if !errors.is_empty() {
-        bail!("{}", errors.join("\ndrivespec: "));
+    if !sink.errors.is_empty() {
+        bail!("{}", sink.errors.join("\ndrivespec: "));
     }
-    Ok(if reports.iter().all(Report::passed) {
+    Ok(if sink.passed {
         Outcome::Pass
     } else {
         Outcome::Fail

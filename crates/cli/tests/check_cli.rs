@@ -1,5 +1,6 @@
 //! `drivespec check` as users run it on the recordings under `corpus/captures/`: exit codes,
-//! detection, the report formats, `--max-violations`, and a truncated file.
+//! detection, the report formats, `--max-violations`, a truncated file,
+//! folders checked in parallel and NDJSON.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -7,7 +8,7 @@
     clippy::panic
 )]
 
-use drivespec_testkit::{run_with, CI};
+use drivespec_testkit::{run_with, temp_dir, CI};
 use std::path::PathBuf;
 
 const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
@@ -226,4 +227,141 @@ fn a_required_family_whose_checks_did_not_run_fails() {
             "{out}"
         );
     }
+}
+
+/// A folder of three recordings (one in a subfolder) and a file that is not a recording.
+fn recordings_folder(name: &str) -> PathBuf {
+    let dir = temp_dir("check", name);
+    std::fs::create_dir_all(dir.join("line")).unwrap();
+    for (from, to) in [
+        ("psd4xx-faults.pcap.gz", "b-plc.pcap.gz"),
+        ("psx3xx-faults.jsonl", "a-master.jsonl"),
+        ("hpd-faults.txt", "line/c-hpd.txt"),
+    ] {
+        std::fs::copy(capture(from), dir.join(to)).unwrap();
+    }
+    std::fs::write(dir.join("README.md"), "not a recording").unwrap();
+    dir
+}
+
+#[test]
+fn a_folder_gives_the_same_merged_report_with_one_or_two_jobs() {
+    let dir = recordings_folder("jobs");
+    let d = dir.display().to_string();
+    let (code1, one, err1) = run_with(BIN, &["check", "-j1", "--report", "json", &d], None, CI);
+    let (code2, two, err2) = run_with(BIN, &["check", "-j", "2", "--report", "json", &d], None, CI);
+    assert_eq!((code1, code2), (1, 1), "{err1}{err2}");
+    assert_eq!(one, two, "the report does not depend on the number of jobs");
+    let v: serde_json::Value = serde_json::from_str(&one).unwrap();
+    let files: Vec<&str> = v["reports"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["file"].as_str().unwrap())
+        .collect();
+    assert_eq!(files.len(), 3, "{files:?}");
+    for (file, ending) in files
+        .iter()
+        .zip(["a-master.jsonl", "b-plc.pcap.gz", "c-hpd.txt"])
+    {
+        assert!(file.ends_with(ending), "sorted by path: {files:?}");
+    }
+    let families: Vec<&str> = v["reports"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["family"].as_str().unwrap())
+        .collect();
+    assert_eq!(families, ["psx3xx", "psd4xx", "hpd"]);
+    assert_eq!(v["failed"], 3);
+    let (code, text, _) = run_with(BIN, &["check", "-j2", &d], None, CI);
+    assert_eq!(code, 1);
+    assert!(
+        text.ends_with("3 files: 3 failed, 0 unreadable\n"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_unreadable_file_among_good_ones_exits_2_names_it_and_reports_the_others() {
+    let dir = temp_dir("check", "unreadable");
+    std::fs::create_dir_all(&dir).unwrap();
+    let missing = dir.join("missing.pcap").display().to_string();
+    let good = [capture("hpd-clean.socat"), capture("psx3xx-clean.csv")];
+    let (code, out, err) = run_with(
+        BIN,
+        &[
+            "check", "-j2", "--report", "json", &good[0], &missing, &good[1],
+        ],
+        None,
+        CI,
+    );
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("missing.pcap"), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let reports = v["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), 2, "{out}");
+    assert!(reports.iter().all(|r| r["verdict"] == "pass"), "{out}");
+    let (code, out, _) = run_with(
+        BIN,
+        &["check", "--report", "ndjson", &good[0], &missing],
+        None,
+        CI,
+    );
+    assert_eq!(code, 2);
+    assert!(
+        out.lines()
+            .any(|l| l.contains("\"unreadable\"") && l.contains("missing.pcap")),
+        "{out}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn ndjson_writes_one_finding_per_line_with_the_schema_and_a_summary_last() {
+    let dir = recordings_folder("ndjson");
+    let d = dir.display().to_string();
+    let (code, out, err) = run_with(BIN, &["check", "--report", "ndjson", &d], None, CI);
+    assert_eq!(code, 1, "{err}");
+    let lines: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+        .collect();
+    assert!(lines
+        .iter()
+        .all(|l| l["schema"] == "drivespec-check-finding/1"));
+    let (_, json, _) = run_with(BIN, &["check", "--report", "json", &d], None, CI);
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let listed: usize = v["reports"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["violations"].as_array().unwrap().len())
+        .sum();
+    let findings: Vec<&serde_json::Value> =
+        lines.iter().filter(|l| l["kind"] == "finding").collect();
+    assert!(listed > 0);
+    assert_eq!(findings.len(), listed);
+    let first = findings[0];
+    for key in [
+        "file",
+        "requirement",
+        "level",
+        "message",
+        "evidence",
+        "event",
+    ] {
+        assert!(first.get(key).is_some(), "{key} missing: {first}");
+    }
+    assert!(lines
+        .iter()
+        .any(|l| l["frame"].is_u64() && l["time"].is_u64()));
+    let summary = lines.last().unwrap();
+    assert_eq!(summary["kind"], "summary");
+    assert_eq!(summary["files"], 3);
+    assert_eq!(summary["findings"], listed);
+    assert_eq!(summary["violation_count"], v["violation_count"]);
+    assert_eq!(lines.len(), listed + 1);
+    let _ = std::fs::remove_dir_all(&dir);
 }
