@@ -506,6 +506,7 @@ fn an_empty_recording_is_nothing_to_check() {
 #[test]
 fn a_byte_order_mark_is_read_past_and_unknown_text_is_not_taken_for_hpd_bytes() {
     let dir = temp_dir("hostile", "text-kinds");
+    std::fs::create_dir_all(&dir).unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../corpus/captures");
     let plain = root.join("psx3xx-faults.jsonl");
     let mut marked = vec![0xef, 0xbb, 0xbf];
