@@ -49,6 +49,10 @@ pub struct ConformArgs {
     /// Stop at the first unexpected failure.
     #[arg(long)]
     fail_fast: bool,
+    /// Run a case that fails unexpectedly up to N more times (real hardware noise); a case
+    /// that then passes is reported as flaky, with its first failure.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    retries: u32,
     /// Seed of the values the cases pick.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -130,6 +134,7 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
         expect: args.expect,
         list: args.list,
         fail_fast: args.fail_fast,
+        retries: args.retries,
         report_dir: args.report_dir,
         junit: args.junit,
         json: args.json,
@@ -211,6 +216,16 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
                 "{} passed ({} acceptable), {} failed, {} skipped ({} expected failures, {} fixed, {} not run) of {} cases against {}",
                 s.passed, s.acceptable, s.failed, s.skipped, s.expected_failures, s.fixed, s.not_run, s.total, r.run.transport
             )?;
+            for c in r.cases.iter().filter(|c| c.status == Status::Flaky) {
+                let first = c.failure.as_ref().map_or("", |f| f.message.as_str());
+                say!(
+                    "flaky: {} failed, then passed when run again ({first})",
+                    c.id
+                )?;
+            }
+            if s.flaky > 0 {
+                say!("{} flaky case(s): passed only when run again", s.flaky)?;
+            }
             for c in &r.coverage_summary {
                 say!(
                     "coverage {}: {} of {} must requirements checked, {} not observable over the interface",

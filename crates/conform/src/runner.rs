@@ -84,6 +84,9 @@ pub struct Options {
     pub list: bool,
     /// `--fail-fast`: stop at the first unexpected failure.
     pub fail_fast: bool,
+    /// `--retries N`: run a case that fails unexpectedly up to N more times; one that then
+    /// passes is `flaky`.
+    pub retries: u32,
     /// Folder of the reports (default `reports`).
     pub report_dir: PathBuf,
     /// JUnit file (default `<report_dir>/conform.junit.xml`).
@@ -117,6 +120,7 @@ impl Default for Options {
             expect: None,
             list: false,
             fail_fast: false,
+            retries: 0,
             report_dir: PathBuf::from("reports"),
             junit: None,
             json: None,
@@ -278,7 +282,24 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             continue;
         }
         let started = Instant::now();
-        let run = session.run(*ci);
+        let mut run = session.run(*ci);
+        let mut first_failure = None;
+        let mut tries = 0;
+        while known.is_none()
+            && run.outcome.failed()
+            && tries < opts.retries
+            && !opts.stop.load(Ordering::Relaxed)
+        {
+            tries += 1;
+            let again = session.run(*ci);
+            if !again.outcome.failed() {
+                if let Outcome::Fail(f) = std::mem::replace(&mut run, again).outcome {
+                    first_failure = Some(f);
+                }
+            } else {
+                run = again;
+            }
+        }
         let answered = run
             .evidence
             .iter()
@@ -287,6 +308,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         let mute = !heard && n + 1 >= MUTE_CASES && !opts.stop.load(Ordering::Relaxed);
         let wall_ms = started.elapsed().as_secs_f64() * 1000.0;
         let status = match (&run.outcome, known) {
+            (Outcome::Pass, None) if first_failure.is_some() => Status::Flaky,
             (Outcome::Pass, None) if run.findings.is_empty() => Status::Pass,
             (Outcome::Pass, None) => Status::Acceptable,
             (Outcome::Pass, Some(_)) => Status::Fixed,
@@ -294,9 +316,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             (Outcome::Fail(_), Some(_)) => Status::ExpectedFailure,
             (Outcome::Skip { .. }, _) => Status::Skipped,
         };
-        let replay = run
-            .outcome
-            .failed()
+        let replay = (run.outcome.failed() || first_failure.is_some())
             .then(|| replay_line(opts, &settings, &info.id));
         let headline = match &run.outcome {
             Outcome::Fail(f) if status == Status::Fail => f.headline(),
@@ -322,14 +342,16 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         if status == Status::Fail && opts.fail_fast {
             stop = true;
         }
-        results.push(case_report(
+        let mut report = case_report(
             info,
             Some(run),
             status,
             known.map(|k| k.reason.clone()),
             replay,
             wall_ms,
-        ));
+        );
+        report.failure = report.failure.take().or(first_failure);
+        results.push(report);
     }
     if mode == Progress::Bar {
         let _ = writeln!(progress);
@@ -535,6 +557,10 @@ fn build_report(
             Status::Acceptable => {
                 counts.passed += 1;
                 counts.acceptable += 1;
+            }
+            Status::Flaky => {
+                counts.passed += 1;
+                counts.flaky += 1;
             }
             Status::Fail => counts.failed += 1,
             Status::ExpectedFailure => counts.expected_failures += 1,

@@ -62,6 +62,9 @@ pub enum Outcome {
     /// The test could not run: unreadable input, unreachable device (`<error message type>`
     /// with its text).
     Errored(Problem),
+    /// Passed when run again after failing (`<rerunFailure message type>` with the failure
+    /// of the first run, as Maven Surefire writes flaky tests).
+    Flaky(Problem),
 }
 
 /// What a failure or an error says.
@@ -186,6 +189,7 @@ fn case(x: &mut String, c: &Case) {
         }
         Outcome::Failed(p) => problem(x, "failure", p),
         Outcome::Errored(p) => problem(x, "error", p),
+        Outcome::Flaky(p) => problem(x, "rerunFailure", p),
     }
     if let Some(out) = &c.output {
         let _ = writeln!(x, "      <system-out>{}</system-out>", escape(out));

@@ -90,6 +90,14 @@ fn case(c: &CaseReport, interrupted: bool) -> Case {
         }
         Status::NotRun => Outcome::Skipped("not run: --fail-fast stopped the run".to_owned()),
         Status::Skipped => Outcome::Skipped(c.skip_reason.clone().unwrap_or_default()),
+        Status::Flaky => Outcome::Flaky(Problem {
+            message: c.failure.as_ref().map_or_else(
+                || "failed, then passed when run again".to_owned(),
+                |f| format!("failed, then passed when run again: {}", f.message),
+            ),
+            kind: "mismatch".to_owned(),
+            text: Some(failure_text(c)),
+        }),
         Status::Fail => {
             let message = match &c.failure {
                 Some(f) => match f.broken() {

@@ -23,6 +23,9 @@ pub enum Status {
     Pass,
     /// Passed, showing one of several outcomes the manual allows (its findings say which).
     Acceptable,
+    /// Failed, then passed when run again (`--retries`): passes the run, counted apart, its
+    /// first failure kept.
+    Flaky,
     /// Failed and not expected to: fails the run.
     Fail,
     /// Failed as the expectations file says.
@@ -41,6 +44,7 @@ impl Status {
         match self {
             Status::Pass => "pass",
             Status::Acceptable => "acceptable",
+            Status::Flaky => "flaky",
             Status::Fail => "fail",
             Status::ExpectedFailure => "expected-failure",
             Status::Fixed => "fixed",
@@ -127,6 +131,9 @@ pub struct Counts {
     pub passed: usize,
     /// Passed with an outcome the manual allows among several (also counted in `passed`).
     pub acceptable: usize,
+    /// Failed, then passed on a retry (also counted in `passed`); present when not 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub flaky: usize,
     /// Failed unexpectedly.
     pub failed: usize,
     /// Failed as expected.
@@ -159,7 +166,7 @@ pub struct CaseReport {
     pub requirements: Vec<String>,
     /// Final status.
     pub status: Status,
-    /// Why it failed (fail and expected-failure).
+    /// Why it failed (fail and expected-failure; the first try of a flaky case).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<Failure>,
     /// Why it was skipped.
@@ -242,4 +249,8 @@ impl Report {
     pub fn json(&self) -> String {
         drivespec_report::json(self)
     }
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
