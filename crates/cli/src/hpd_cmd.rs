@@ -355,7 +355,12 @@ fn build(spec: &Spec, family: &Family, what: EncodeWhat) -> Result<Message> {
                 _ => bail!("a broadcast writes a whole parameter, not a bit"),
             }
         }
-        EncodeWhat::PlcRead { addr, at, lun } => Message::ReadPlc { addr, lun, par: at },
+        EncodeWhat::PlcRead { addr, at, lun } => {
+            let codec =
+                PlcCodec::from_spec(spec).ok_or_else(|| anyhow!("the spec has no PLC table"))?;
+            in_plc_area(&codec, at, usize::from(lun))?;
+            Message::ReadPlc { addr, lun, par: at }
+        }
         EncodeWhat::PlcWrite { addr, at, listing } => {
             let codec =
                 PlcCodec::from_spec(spec).ok_or_else(|| anyhow!("the spec has no PLC table"))?;
@@ -367,6 +372,7 @@ fn build(spec: &Spec, family: &Family, what: EncodeWhat) -> Result<Message> {
                     bytes.len()
                 )
             })?;
+            in_plc_area(&codec, at, bytes.len())?;
             Message::WritePlc {
                 addr,
                 par: at,
@@ -374,6 +380,20 @@ fn build(spec: &Spec, family: &Family, what: EncodeWhat) -> Result<Message> {
             }
         }
     })
+}
+
+/// Refuses PLC bytes `at`…`at + len − 1` outside the PLC area (3.8.1: 0x00–0x7F).
+fn in_plc_area(codec: &PlcCodec, at: u8, len: usize) -> Result<()> {
+    let plc = codec.plc();
+    let last = usize::from(at) + len.max(1) - 1;
+    if at < plc.first_address || last > usize::from(plc.last_address) {
+        bail!(
+            "PLC bytes 0x{at:02X}-0x{last:02X} lie outside the PLC area 0x{:02X}-0x{:02X} (3.8.1)",
+            plc.first_address,
+            plc.last_address
+        );
+    }
+    Ok(())
 }
 
 /// Arguments of `drivespec plc hpd`.

@@ -122,7 +122,7 @@ fn encode_rebuilds_the_manual_requests_from_names() {
 
 #[test]
 fn encode_errors_are_one_line_with_exit_2() {
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 6] = [
         (
             &["write", "Pr33=99.9"],
             "drivespec: Pr33 = 999 outside range 100..500\n",
@@ -135,6 +135,14 @@ fn encode_errors_are_one_line_with_exit_2() {
         (
             &["bit", "b99.16=1"],
             "drivespec: bit 16 outside Pb99 (16 bits)\n",
+        ),
+        (
+            &["plc-write", "--at", "200", "LD 90.4"],
+            "drivespec: PLC bytes 0xC8-0xC9 lie outside the PLC area 0x00-0x7F (3.8.1)\n",
+        ),
+        (
+            &["plc-read", "--at", "0x7E", "--lun", "4"],
+            "drivespec: PLC bytes 0x7E-0x81 lie outside the PLC area 0x00-0x7F (3.8.1)\n",
         ),
     ];
     for (args, want) in cases {
