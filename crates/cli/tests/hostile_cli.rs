@@ -167,6 +167,18 @@ fn spec_files_that_never_end_are_refused() {
 }
 
 #[test]
+fn a_folder_named_like_a_spec_file_is_refused() {
+    let dir = spec_with("extra.toml", |p| std::fs::create_dir(p).unwrap());
+    let (code, stdout, stderr) = run(BIN, &["--spec", dir.to_str().unwrap(), "spec", "check"]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    assert!(
+        stdout.contains("a folder named like a spec file"),
+        "{stdout}"
+    );
+}
+
+#[test]
 fn a_bad_value_says_what_is_wrong_in_one_line() {
     for (args, want) in [
         (

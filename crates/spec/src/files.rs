@@ -112,14 +112,24 @@ fn walk(root: &Path, dir: &Path, depth: usize, out: &mut SpecFiles, problems: &m
     };
     for entry in entries.flatten() {
         let path = entry.path();
-        if path.is_dir() {
-            walk(root, &path, depth + 1, out, problems);
-            continue;
-        }
-        if path.extension().is_none_or(|e| e != "toml") {
-            continue;
-        }
+        let toml = path.extension().is_some_and(|e| e == "toml");
         let shown = path.display().to_string();
+        if path.is_dir() {
+            if toml {
+                problems.push(Problem::file(
+                    shown,
+                    ProblemKind::Io {
+                        message: "a folder named like a spec file".to_owned(),
+                    },
+                ));
+            } else {
+                walk(root, &path, depth + 1, out, problems);
+            }
+            continue;
+        }
+        if !toml {
+            continue;
+        }
         if out.files.len() >= MAX_FILES {
             problems.push(Problem::file(
                 shown,
