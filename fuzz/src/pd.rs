@@ -6,16 +6,23 @@ use drivespec_psd4xx::{CommandCode, Direction, Pkw, RecordRead, RecordWrite, Res
 use drivespec_spec::Spec;
 use std::sync::OnceLock;
 
+// The `expect`s below cannot fail on any input: the built-in spec and the rules built from it
+// are checked by `drivespec spec check` in CI. The re-encoding ones are the harness's
+// invariants: a panic there is the finding (see the crate doc).
+
+/// The built-in spec, loaded once.
 pub(crate) fn spec() -> &'static Spec {
     static SPEC: OnceLock<Spec> = OnceLock::new();
     SPEC.get_or_init(|| Spec::builtin().expect("the built-in spec loads"))
 }
 
+/// The PSD4xx codec rules of the built-in spec.
 pub(crate) fn psd() -> &'static drivespec_psd4xx::Rules {
     static RULES: OnceLock<drivespec_psd4xx::Rules> = OnceLock::new();
     RULES.get_or_init(|| drivespec_psd4xx::Rules::from_spec(spec()).expect("PSD4xx rules"))
 }
 
+/// The PSx3xx codec rules of the built-in spec.
 pub(crate) fn psx() -> &'static drivespec_psx3xx::Rules<'static> {
     static RULES: OnceLock<drivespec_psx3xx::Rules<'static>> = OnceLock::new();
     RULES.get_or_init(|| drivespec_psx3xx::Rules::from_spec(spec()).expect("PSx3xx rules"))

@@ -216,3 +216,32 @@ impl<'s, F: CyclicFamily<'s>, P: CyclicFuzz<'s, Family = F>> Target for CyclicTa
         engine::requirement_ids(self.part.spec())
     }
 }
+
+/// The detail of a mismatched input image in a signature: `parts` already found, then the
+/// status bits that differ (`status-b0+6`), `speed`, `position`; `input-image` when the last
+/// cycle of the step agrees and an earlier one did not.
+pub(crate) fn image_differences(
+    mut parts: Vec<String>,
+    status_bits: u16,
+    speed: bool,
+    position: bool,
+) -> String {
+    if status_bits != 0 {
+        let list: Vec<String> = (0..16u16)
+            .filter(|b| status_bits & (1 << b) != 0)
+            .map(|b| b.to_string())
+            .collect();
+        parts.push(format!("status-b{}", list.join("+")));
+    }
+    if speed {
+        parts.push("speed".to_owned());
+    }
+    if position {
+        parts.push("position".to_owned());
+    }
+    if parts.is_empty() {
+        "input-image".to_owned()
+    } else {
+        parts.join(",")
+    }
+}

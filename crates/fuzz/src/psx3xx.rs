@@ -15,7 +15,7 @@
 
 mod sequences;
 
-use crate::cyclic_target::{self, Bound, CyclicFuzz, CyclicTarget};
+use crate::cyclic_target::{self, image_differences, Bound, CyclicFuzz, CyclicTarget};
 use crate::replay::Step;
 use drivespec_conform::case::{CaseInfo, CaseRun, Role};
 use drivespec_conform::cyclic::Peer;
@@ -150,27 +150,12 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
         let (Some(e), Some(g)) = (image(r.expected.as_ref()), image(r.got.as_ref())) else {
             return "no-image".to_owned();
         };
-        let mut parts: Vec<String> = Vec::new();
-        let bits = e.status ^ g.status;
-        if bits != 0 {
-            let list: Vec<String> = (0..16u16)
-                .filter(|b| bits & (1 << b) != 0)
-                .map(|b| b.to_string())
-                .collect();
-            parts.push(format!("status-b{}", list.join("+")));
-        }
-        if e.rpm != g.rpm {
-            parts.push("speed".to_owned());
-        }
-        if e.actual != g.actual {
-            parts.push("position".to_owned());
-        }
-        if parts.is_empty() {
-            // The last cycle of the step agrees; an earlier one did not.
-            "input-image".to_owned()
-        } else {
-            parts.join(",")
-        }
+        image_differences(
+            Vec::new(),
+            e.status ^ g.status,
+            e.rpm != g.rpm,
+            e.actual != g.actual,
+        )
     }
 }
 
