@@ -1,12 +1,17 @@
 //! Opening a recording: gzip is peeled off (detected by its magic `1f 8b`, RFC 1952 2.3.1)
 //! and the first bytes are kept so the format can be detected without seeking.
 //!
+//! Every gzip member is read in turn (RFC 1952 2.2); bytes after the last complete member
+//! that do not start another one end the stream with a [`GzipTail`] error at their place,
+//! after everything before them was delivered. A read error never drops bytes read before
+//! it: it is kept and raised when the reader gets there.
+//!
 //! Memory: the kept prefix is at most [`PEEK`] bytes, or one pcapng section header block when
 //! a caller asks for it (bounded by that caller's block limit). Offsets count bytes of the
 //! decompressed stream.
 
 use crate::detect::{detect, Detection};
-use flate2::read::MultiGzDecoder;
+use flate2::bufread::GzDecoder;
 use std::io::{self, BufRead, Read};
 
 /// Bytes read ahead for format detection.
@@ -25,12 +30,35 @@ pub struct ReadError {
     pub source: io::Error,
 }
 
-/// Bytes before an inner reader (our doc: module `input`).
+/// Bytes after the last complete gzip member that are not gzip (our doc: module `input`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("the {members} gzip member(s) before compressed byte {offset} were read; the bytes from there on are not gzip")]
+pub struct GzipTail {
+    /// Complete members read.
+    pub members: u64,
+    /// Offset in the compressed file of the first byte that is not gzip.
+    pub offset: u64,
+}
+
+/// Bytes before an inner reader, then a read error met while filling them (our doc: module
+/// `input`).
 #[derive(Debug)]
 struct Prefixed<R> {
     prefix: Vec<u8>,
     pos: usize,
+    pending: Option<io::Error>,
     inner: R,
+}
+
+impl<R> Prefixed<R> {
+    fn new(prefix: Vec<u8>, pending: Option<io::Error>, inner: R) -> Prefixed<R> {
+        Prefixed {
+            prefix,
+            pos: 0,
+            pending,
+            inner,
+        }
+    }
 }
 
 impl<R: Read> Read for Prefixed<R> {
@@ -47,14 +75,106 @@ impl<R: Read> Read for Prefixed<R> {
             }
             return Ok(n);
         }
+        if let Some(e) = self.pending.take() {
+            return Err(e);
+        }
         self.inner.read(buf)
+    }
+}
+
+/// Counts the bytes read from the inner reader.
+#[derive(Debug)]
+struct Counted<R> {
+    inner: R,
+    count: u64,
+}
+
+impl<R: Read> Read for Counted<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.count += n as u64;
+        Ok(n)
+    }
+}
+
+/// The gzip members of a stream one after the other (RFC 1952 2.2), ending at bytes that are
+/// not gzip with a [`GzipTail`] error.
+#[derive(Debug)]
+struct Members<R> {
+    decoder: Option<GzDecoder<io::BufReader<Counted<R>>>>,
+    /// Complete members read.
+    members: u64,
+    /// Whether the current member has delivered nothing yet.
+    fresh: bool,
+    /// Compressed offset where the current member starts.
+    start: u64,
+}
+
+impl<R: Read> Members<R> {
+    fn new(inner: R) -> Members<R> {
+        let reader = io::BufReader::new(Counted { inner, count: 0 });
+        Members {
+            decoder: Some(GzDecoder::new(reader)),
+            members: 0,
+            fresh: true,
+            start: 0,
+        }
+    }
+
+    fn tail(&self) -> io::Error {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            GzipTail {
+                members: self.members,
+                offset: self.start,
+            },
+        )
+    }
+}
+
+impl<R: Read> Read for Members<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        loop {
+            let Some(decoder) = self.decoder.as_mut() else {
+                return Ok(0);
+            };
+            match decoder.read(buf) {
+                Ok(0) => {
+                    let Some(done) = self.decoder.take() else {
+                        return Ok(0);
+                    };
+                    self.members += 1;
+                    let mut reader = done.into_inner();
+                    let buffered = reader.buffer().len() as u64;
+                    self.start = reader.get_ref().count - buffered;
+                    if reader.fill_buf()?.is_empty() {
+                        return Ok(0);
+                    }
+                    self.fresh = true;
+                    self.decoder = Some(GzDecoder::new(reader));
+                }
+                Ok(n) => {
+                    self.fresh = false;
+                    return Ok(n);
+                }
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => return Err(e),
+                Err(_) if self.fresh && self.members > 0 => {
+                    self.decoder = None;
+                    return Err(self.tail());
+                }
+                Err(e) => return Err(e),
+            }
+        }
     }
 }
 
 #[derive(Debug)]
 enum Source<R> {
     Plain(Prefixed<R>),
-    Gzip(Box<MultiGzDecoder<Prefixed<R>>>),
+    Gzip(Box<Members<Prefixed<R>>>),
 }
 
 impl<R: Read> Read for Source<R> {
@@ -75,7 +195,8 @@ pub struct Input<R> {
     delivered: u64,
 }
 
-/// Reads until `buf` holds `want` bytes or the reader ends.
+/// Reads until `buf` holds `want` bytes or the reader ends; on an error `buf` keeps what came
+/// before it.
 fn fill<R: Read>(r: &mut R, buf: &mut Vec<u8>, want: usize) -> io::Result<()> {
     let mut chunk = [0u8; 1024];
     while buf.len() < want {
@@ -102,32 +223,26 @@ impl<R: Read> Input<R> {
         })?;
         let gzip = raw.starts_with(&[0x1f, 0x8b]);
         let mut source = if gzip {
-            Source::Gzip(Box::new(MultiGzDecoder::new(Prefixed {
-                prefix: raw,
-                pos: 0,
-                inner: reader,
-            })))
+            Source::Gzip(Box::new(Members::new(Prefixed::new(raw, None, reader))))
         } else {
-            Source::Plain(Prefixed {
-                prefix: raw,
-                pos: 0,
-                inner: reader,
-            })
+            Source::Plain(Prefixed::new(raw, None, reader))
         };
         let mut prefix = Vec::new();
-        fill(&mut source, &mut prefix, PEEK).map_err(|source| ReadError {
-            offset: 0,
-            gzip,
-            source,
-        })?;
+        let pending = match fill(&mut source, &mut prefix, PEEK) {
+            Ok(()) => None,
+            Err(e) if !prefix.is_empty() => Some(e),
+            Err(source) => {
+                return Err(ReadError {
+                    offset: 0,
+                    gzip,
+                    source,
+                })
+            }
+        };
         let mut detection = detect(&prefix);
         detection.gzip = gzip;
         Ok(Input {
-            inner: Prefixed {
-                prefix,
-                pos: 0,
-                inner: source,
-            },
+            inner: Prefixed::new(prefix, pending, source),
             detection,
             delivered: 0,
         })
@@ -153,12 +268,19 @@ impl<R: Read> Input<R> {
         if self.peek().len() < want {
             let mut rest = self.peek().to_vec();
             let gzip = self.detection.gzip;
-            let offset = self.delivered + rest.len() as u64;
-            fill(&mut self.inner.inner, &mut rest, want).map_err(|source| ReadError {
-                offset,
-                gzip,
-                source,
-            })?;
+            if self.inner.pending.is_none() {
+                let before = rest.len();
+                if let Err(e) = fill(&mut self.inner.inner, &mut rest, want) {
+                    if rest.len() == before {
+                        return Err(ReadError {
+                            offset: self.delivered + before as u64,
+                            gzip,
+                            source: e,
+                        });
+                    }
+                    self.inner.pending = Some(e);
+                }
+            }
             self.inner.prefix = rest;
             self.inner.pos = 0;
         }

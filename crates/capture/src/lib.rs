@@ -34,6 +34,6 @@ pub mod write;
 
 pub use bytes::{Endian, Truncated};
 pub use detect::{detect, Detection, Format};
-pub use input::Input;
+pub use input::{GzipTail, Input};
 pub use link::LinkType;
 pub use pcap::{CaptureError, CaptureReader, Record, RecordRef};

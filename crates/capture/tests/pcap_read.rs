@@ -201,6 +201,45 @@ fn a_corrupt_gzip_stream_is_a_read_error() {
     );
 }
 
+#[test]
+fn every_gzip_member_is_read_and_bytes_after_them_are_a_read_error_at_their_place() {
+    let plain = pcapng(Endian::Little);
+    let (all, _) = read_all(&plain);
+    // The file split in two members (RFC 1952 2.2) reads as one stream.
+    let cut = plain.len() / 2;
+    let mut two = Vec::new();
+    for part in [&plain[..cut], &plain[cut..]] {
+        let mut gz = GzEncoder::new(Vec::new(), flate2::Compression::default());
+        gz.write_all(part).unwrap();
+        two.extend(gz.finish().unwrap());
+    }
+    let (records, err) = read_all(&two);
+    assert!(err.is_none(), "{err:?}");
+    assert_eq!(records, all);
+    // Garbage after them: every record is read, then the error names the place.
+    let members = two.len() as u64;
+    two.extend_from_slice(b"garbage here");
+    let (records, err) = read_all(&two);
+    assert_eq!(records, all);
+    let Some(CaptureError::Read(e)) = err else {
+        panic!("{err:?}")
+    };
+    assert!(e.gzip);
+    assert_eq!(e.offset, plain.len() as u64, "{e}");
+    let tail = e
+        .source
+        .get_ref()
+        .and_then(|s| s.downcast_ref::<drivespec_capture::GzipTail>())
+        .copied();
+    assert_eq!(
+        tail,
+        Some(drivespec_capture::GzipTail {
+            members: 2,
+            offset: members
+        })
+    );
+}
+
 /// Offsets where a record or block starts or the file ends: cuts there leave a valid file.
 fn boundaries(bytes: &[u8], first: u64) -> Vec<u64> {
     let (records, _) = read_all(bytes);
