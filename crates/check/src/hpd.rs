@@ -362,23 +362,9 @@ impl<'s> HpdChecker<'s> {
                 "drive {a}: {n} request(s) without answer (lost, or no drive at that address)"
             ));
         }
-        let skipped = self
-            .rec
-            .view()
-            .frames
-            .get("unreadable line")
-            .copied()
-            .unwrap_or(0);
-        if self.events == 0 && skipped > 0 && self.rec.view().error.is_none() {
-            self.rec.report().error = Some(crate::report::InputFault {
-                message: format!(
-                    "no readable line: all {skipped} line(s) were skipped (see the notes)"
-                ),
-                offset: None,
-            });
-        }
-        let latency = self.latency;
         let events = self.events;
+        self.rec.report().unreadable_lines(events);
+        let latency = self.latency;
         let r = self.rec.report();
         r.events = events;
         if latency.count > 0 {

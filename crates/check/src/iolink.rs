@@ -867,21 +867,7 @@ impl<'s> IoLinkChecker<'s> {
     /// Ends the log and returns the report.
     pub fn finish(mut self) -> Report {
         let events = self.events;
-        let skipped = self
-            .rec
-            .view()
-            .frames
-            .get("unreadable line")
-            .copied()
-            .unwrap_or(0);
-        if events == 0 && skipped > 0 && self.rec.view().error.is_none() {
-            self.rec.report().error = Some(InputFault {
-                message: format!(
-                    "no readable line: all {skipped} line(s) were skipped (see the notes)"
-                ),
-                offset: None,
-            });
-        }
+        self.rec.report().unreadable_lines(events);
         let ports = std::mem::take(&mut self.ports);
         let r = self.rec.report();
         r.events = events;

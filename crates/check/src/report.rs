@@ -557,6 +557,33 @@ impl Report {
             .collect()
     }
 
+    /// Says how many lines of a text log were unreadable; when they are more than half of the
+    /// lines (or all of them) reading counts as failed: a verdict on the rest would be a verdict
+    /// on a fraction of the recording. `read` is the number of lines read.
+    pub fn unreadable_lines(&mut self, read: u64) {
+        let skipped = self.frames.get("unreadable line").copied().unwrap_or(0);
+        if skipped == 0 || self.error.is_some() {
+            return;
+        }
+        let total = skipped.saturating_add(read);
+        let share = skipped as f64 * 100.0 / total as f64;
+        let said =
+            format!("{skipped} of {total} line(s) ({share:.2} %) were unreadable and skipped");
+        if skipped > read {
+            let message = if read == 0 {
+                format!("no readable line: all {skipped} line(s) were skipped (see the notes)")
+            } else {
+                format!("{said}, more than half: not judged (see the notes)")
+            };
+            self.error = Some(InputFault {
+                message,
+                offset: None,
+            });
+        } else {
+            self.notes.insert(0, said);
+        }
+    }
+
     /// Adds a note, keeping at most [`MAX_NOTES`].
     pub fn note(&mut self, text: impl Into<String>) {
         if self.notes.len() < MAX_NOTES {
