@@ -120,7 +120,8 @@ pub fn decode(args: DecodeArgs, ctx: &Context) -> Result<Outcome> {
         Format::Json => say!("{}", json(&out))?,
         Format::Text => say_raw!("{}", decoded_text(&out, args.stream.is_some()))?,
     }
-    Ok(if out.discarded.is_empty() {
+    let breaches = out.frames.iter().any(|f| f.message.breaks.is_some());
+    Ok(if out.discarded.is_empty() && !breaches {
         Outcome::Pass
     } else {
         Outcome::Fail
@@ -175,10 +176,13 @@ fn decoded_text(out: &Decoded, stream: bool) -> String {
         if m.lun.is_some() {
             fields.push_str(", checksum ok");
         }
+        let breach = m.breaks.as_ref().map_or(String::new(), |b| {
+            format!("    breaks {}: {}\n", b.requirement, b.text)
+        });
         items.push((
             f.offset,
             format!(
-                "@{}  {}\n    {}\n    {}\n",
+                "@{}  {}\n    {}\n    {}\n{breach}",
                 f.offset, f.bytes, m.summary, fields
             ),
         ));
@@ -384,16 +388,10 @@ fn build(spec: &Spec, family: &Family, what: EncodeWhat) -> Result<Message> {
 
 /// Refuses PLC bytes `at`…`at + len − 1` outside the PLC area (3.8.1: 0x00–0x7F).
 fn in_plc_area(codec: &PlcCodec, at: u8, len: usize) -> Result<()> {
-    let plc = codec.plc();
-    let last = usize::from(at) + len.max(1) - 1;
-    if at < plc.first_address || last > usize::from(plc.last_address) {
-        bail!(
-            "PLC bytes 0x{at:02X}-0x{last:02X} lie outside the PLC area 0x{:02X}-0x{:02X} (3.8.1)",
-            plc.first_address,
-            plc.last_address
-        );
+    match codec.outside_area(at, len) {
+        Some(outside) => bail!("{outside} (3.8.1)"),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Arguments of `drivespec plc hpd`.

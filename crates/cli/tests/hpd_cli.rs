@@ -79,6 +79,20 @@ fn decode_reports_a_bad_checksum_and_exits_1() {
 }
 
 #[test]
+fn decode_flags_plc_bytes_outside_the_area_and_exits_1() {
+    // A PLC write of `LD 90.4` at 0x80, one byte past the area (4.1: 0x00–0x7F).
+    let (code, out, _) = run(BIN, &["decode", "hpd", "7E 60 02 80 40 5A 7C"]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        out.contains("breaks HPD-PLC-038: PLC bytes 0x80-0x81 lie outside the PLC area 0x00-0x7F"),
+        "{out}"
+    );
+    // The same bytes at 0x7C are inside.
+    let (code, out, _) = run(BIN, &["decode", "hpd", "7E 60 02 7C 40 5A 78"]);
+    assert_eq!((code, out.contains("breaks")), (0, false), "{out}");
+}
+
+#[test]
 fn decode_rejects_odd_hex_with_exit_2() {
     let (code, out, err) = run(BIN, &["decode", "hpd", "7E 8"]);
     assert_eq!((code, out.as_str()), (2, ""));

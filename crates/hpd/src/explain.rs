@@ -47,8 +47,20 @@ pub struct Explained {
     /// PLC instructions in the data, as listing lines.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub instructions: Vec<String>,
+    /// The rule of the manual the message breaks, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub breaks: Option<Breach>,
     /// The whole message in one sentence.
     pub summary: String,
+}
+
+/// A rule of the manual a message breaks.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Breach {
+    /// Requirement ID.
+    pub requirement: &'static str,
+    /// What is wrong.
+    pub text: String,
 }
 
 /// One bit written by a bit change.
@@ -61,6 +73,14 @@ pub struct BitWrite {
     pub name: Option<String>,
     /// New value.
     pub value: u8,
+}
+
+/// HPD-PLC-038 when PLC bytes `par`…`par + len − 1` lie outside the program area (4.1, 4.2).
+fn outside_area(plc: Option<&PlcCodec>, par: u8, len: usize) -> Option<Breach> {
+    plc?.outside_area(par, len).map(|o| Breach {
+        requirement: "HPD-PLC-038",
+        text: o.to_string(),
+    })
 }
 
 /// Describes `msg` with the HPD family's parameters and PLC instruction set; `request` is
@@ -87,6 +107,7 @@ pub fn explain(
         shown: None,
         bits: Vec::new(),
         instructions: Vec::new(),
+        breaks: None,
         summary: String::new(),
     };
     let drive = msg.addr();
@@ -101,6 +122,7 @@ pub fn explain(
         Message::ReadPlc { lun, par, .. } => {
             e.lun = Some(lun);
             e.par = Some(par);
+            e.breaks = outside_area(plc, par, usize::from(lun));
             e.summary = format!("read {lun} PLC byte(s) at {par:#04x} from drive {drive}");
         }
         Message::Response { par, data, .. } if matches!(request, Some(Message::ReadPlc { .. })) => {
@@ -130,6 +152,7 @@ pub fn explain(
             e.par = Some(par);
             e.data = Some(to_hex(data.as_slice()));
             e.instructions = instructions(plc, par, &data);
+            e.breaks = outside_area(plc, par, usize::from(data.len()));
             let listing = listing(&e.instructions);
             e.summary = format!("write PLC bytes at {par:#04x} on drive {drive}{listing}");
         }

@@ -98,6 +98,29 @@ pub struct Instr {
     pub operands: Operands,
 }
 
+/// PLC bytes addressed outside the program area (3.8.1, 4.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutsideArea {
+    /// First byte addressed.
+    pub first: u8,
+    /// Last byte addressed.
+    pub last: usize,
+    /// First byte of the area.
+    pub area_first: u8,
+    /// Last byte of the area.
+    pub area_last: u8,
+}
+
+impl std::fmt::Display for OutsideArea {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "PLC bytes 0x{:02X}-0x{:02X} lie outside the PLC area 0x{:02X}-0x{:02X}",
+            self.first, self.last, self.area_first, self.area_last
+        )
+    }
+}
+
 /// Encodes and decodes PLC instructions with the spec's instruction table.
 #[derive(Debug, Clone)]
 pub struct PlcCodec {
@@ -114,6 +137,20 @@ impl PlcCodec {
     /// The spec's PLC table.
     pub fn plc(&self) -> &Plc {
         &self.plc
+    }
+
+    /// The PLC bytes `at`…`at + len − 1` when they reach outside the program area (3.8.1,
+    /// 4.1: 0x00–0x7F); `None` inside it.
+    pub fn outside_area(&self, at: u8, len: usize) -> Option<OutsideArea> {
+        let last = usize::from(at) + len.max(1) - 1;
+        (at < self.plc.first_address || last > usize::from(self.plc.last_address)).then_some(
+            OutsideArea {
+                first: at,
+                last,
+                area_first: self.plc.first_address,
+                area_last: self.plc.last_address,
+            },
+        )
     }
 
     /// Length in bytes of the instruction with `code`.

@@ -6,7 +6,7 @@ mod interp;
 mod listing;
 mod program;
 
-pub use codec::{Instr, Operands, PlcCodec, PlcError};
+pub use codec::{Instr, Operands, OutsideArea, PlcCodec, PlcError};
 pub use interp::{PlcRuntime, PlcState, ZeroFlag};
 pub use listing::ListingError;
 pub use program::{Effects, Program, ProgramIssue};
