@@ -231,6 +231,40 @@ fn spec_scales_that_are_not_finite_or_zero_are_refused() {
     }
 }
 
+#[test]
+fn spec_empty_ranges_and_circular_priorities_are_refused() {
+    let edits: [(&str, &str, &str, &str, &str); 2] = [
+        (
+            "empty-range",
+            "hpd/parameters.toml",
+            "range = [[-10000, 10000]]",
+            "range = []",
+            "a range needs at least one [min, max] interval",
+        ),
+        (
+            "priority-circle",
+            "psd4xx/bits.toml",
+            "priority_over = [10]",
+            "priority_over = [0]",
+            "priority_over goes round in a circle (bit 0 over 0)",
+        ),
+    ];
+    for (name, file, from, to, says) in edits {
+        let dir = spec_with(name, |_| {});
+        let path = dir.join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains(from), "{name}");
+        std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+        let (code, stdout, stderr) = run(BIN, &["--spec", dir.to_str().unwrap(), "spec", "check"]);
+        let _ = std::fs::remove_dir_all(&dir);
+        assert!(code == 1 || code == 2, "{name}: {code} {stdout}{stderr}");
+        assert!(
+            stdout.contains(says) || stderr.contains(says),
+            "{name}: {stdout}{stderr}"
+        );
+    }
+}
+
 #[cfg(unix)]
 #[test]
 fn report_paths_follow_symlinks_and_never_replace_a_device() {
@@ -551,4 +585,73 @@ fn a_byte_order_mark_is_read_past_and_unknown_text_is_not_taken_for_hpd_bytes() 
         assert_eq!(err.lines().count(), 1, "{name}: {err}");
     }
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A recording from `corpus/captures`.
+fn corpus(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../corpus/captures")
+        .join(name)
+}
+
+#[test]
+fn gzip_with_trailing_garbage_is_checked_up_to_the_garbage_and_says_where_it_starts() {
+    let dir = temp_dir("hostile", "gzip-tail");
+    std::fs::create_dir_all(&dir).unwrap();
+    let gz = std::fs::read(corpus("psd4xx-faults.pcap.gz")).unwrap();
+    let file = dir.join("tail.pcap.gz");
+    let mut bytes = gz.clone();
+    bytes.extend_from_slice(b"trailing garbage");
+    std::fs::write(&file, &bytes).unwrap();
+    let (clean_code, clean, _) = run(
+        BIN,
+        &["check", corpus("psd4xx-faults.pcap.gz").to_str().unwrap()],
+    );
+    let (code, out, err) = run(BIN, &["check", file.to_str().unwrap()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(clean_code, 1, "{clean}");
+    assert_eq!(code, 2, "{out}{err}");
+    let said = format!(
+        "the 1 gzip member(s) before compressed byte {} were read; the bytes from there on are not gzip",
+        gz.len()
+    );
+    assert!(err.contains(&said), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    // Every violation of the readable part is still listed.
+    let listed = |text: &str| {
+        text.lines()
+            .filter(|l| l.contains("PSD-") || l.contains("PN-"))
+            .count()
+    };
+    assert_eq!(listed(&out), listed(&clean), "{out}");
+}
+
+#[test]
+fn a_log_of_mostly_unreadable_lines_is_not_judged() {
+    let dir = temp_dir("hostile", "unreadable-lines");
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = std::fs::read_to_string(corpus("hpd-clean.txt")).unwrap();
+    let lines = log.lines().count();
+    let with = |junk: usize| {
+        let mut text = log.clone();
+        for i in 0..junk {
+            text.push_str(&format!("not a serial line {i}\n"));
+        }
+        let file = dir.join(format!("junk-{junk}.txt"));
+        std::fs::write(&file, text).unwrap();
+        run(BIN, &["check", "--format", "text", file.to_str().unwrap()])
+    };
+    // A few unreadable lines: judged, and the share is said.
+    let (code, out, err) = with(3);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("3 of "), "{out}");
+    assert!(
+        out.contains("line(s)") && out.contains("were unreadable and skipped"),
+        "{out}"
+    );
+    // More unreadable lines than readable ones: not a pass.
+    let (code, out, err) = with(lines * 2);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(err.contains("more than half: not judged"), "{err}");
 }

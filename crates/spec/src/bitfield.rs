@@ -151,6 +151,46 @@ impl Bitfield {
         self.bits.iter().find(|b| b.bit == n)
     }
 
+    /// A circle of bits each winning over the next by `priority_over` (first bit repeated at
+    /// the end), if the rules make one: then no bit wins.
+    pub fn priority_cycle(&self) -> Option<Vec<u32>> {
+        let over = |n: u32| {
+            self.bit(n)
+                .into_iter()
+                .flat_map(|b| b.rules.iter().flat_map(|r| r.priority_over.iter().copied()))
+        };
+        // Depth-first search; `path` is the chain from the start, `done` the bits whose every
+        // chain is known to end.
+        let mut done: Vec<u32> = Vec::new();
+        for start in self.bits.iter().map(|b| b.bit) {
+            if done.contains(&start) {
+                continue;
+            }
+            let mut path: Vec<(u32, Vec<u32>)> = vec![(start, over(start).collect())];
+            while let Some((bit, next)) = path.last_mut() {
+                let bit = *bit;
+                match next.pop() {
+                    Some(n) => {
+                        if let Some(from) = path.iter().position(|(b, _)| *b == n) {
+                            let mut circle: Vec<u32> =
+                                path.iter().skip(from).map(|(b, _)| *b).collect();
+                            circle.push(n);
+                            return Some(circle);
+                        }
+                        if !done.contains(&n) && self.bit(n).is_some() {
+                            path.push((n, over(n).collect()));
+                        }
+                    }
+                    None => {
+                        done.push(bit);
+                        path.pop();
+                    }
+                }
+            }
+        }
+        None
+    }
+
     /// Mask of the bits the master must keep 0.
     pub fn must_be_zero_mask(&self) -> u64 {
         self.bits

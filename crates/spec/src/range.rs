@@ -5,8 +5,25 @@ use std::fmt;
 
 /// A union of inclusive raw intervals, e.g. `[[-6, -1], [1, 1]]` for PSD par 96.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(transparent)]
+#[serde(try_from = "Vec<[i64; 2]>", into = "Vec<[i64; 2]>")]
 pub struct Ranges(pub Vec<[i64; 2]>);
+
+impl TryFrom<Vec<[i64; 2]>> for Ranges {
+    type Error = &'static str;
+
+    fn try_from(v: Vec<[i64; 2]>) -> Result<Ranges, &'static str> {
+        if v.is_empty() {
+            return Err("a range needs at least one [min, max] interval");
+        }
+        Ok(Ranges(v))
+    }
+}
+
+impl From<Ranges> for Vec<[i64; 2]> {
+    fn from(r: Ranges) -> Vec<[i64; 2]> {
+        r.0
+    }
+}
 
 impl Ranges {
     /// One interval.

@@ -359,6 +359,14 @@ impl Validator<'_> {
                     },
                 );
             }
+            if let Some(circle) = b.priority_cycle() {
+                let circle: Vec<String> = circle.iter().map(u32::to_string).collect();
+                let message = format!(
+                    "priority_over goes round in a circle (bit {}): no bit wins",
+                    circle.join(" over ")
+                );
+                self.push(&b.file, rec.clone(), ProblemKind::Invalid { message });
+            }
             let mut seen = Vec::new();
             for bit in &b.bits {
                 let brec = format!("{rec} bit {}", bit.bit);
