@@ -832,7 +832,7 @@ impl<'s> PsdDrive<'s> {
             return;
         };
         let slack = self.options.speed_slack_percent;
-        let limit = max.saturating_mul(100 + i64::try_from(slack).unwrap_or(0)) / 100;
+        let limit = max.saturating_mul(i64::try_from(slack).unwrap_or(0).saturating_add(100)) / 100;
         let who = self.model.map_or_else(
             || "the fastest PSD4xx model (model unknown)".to_owned(),
             |m| m.name.clone(),
