@@ -890,11 +890,11 @@ class Scenario:
             for fn in self.at_cycle.get(cycle, []):
                 fn(cap, base + 300, self)
             out = ctrl.next_output(cycle, inp)
-            stop = cycle <= self.startup_stop_ms
             frame_out = {"pkw": out[:3], "control": out[3], "target": out[4], "tags": [],
-                         "cycle": cycle}
+                         "cycle": cycle, "stop": cycle <= self.startup_stop_ms}
             for fn in self.out_hooks:
                 fn(frame_out)
+            stop = frame_out["stop"]
             o_img = output_image(frame_out["pkw"], frame_out["control"], frame_out["target"])
             if stop:
                 # 3.9: IOPS bad while the CPU is in STOP; the controller zeroes its outputs.
@@ -1326,11 +1326,44 @@ def no_connect():
     return s
 
 
+def controller_stop():
+    s = Scenario(
+        "psd426-controller-stop",
+        "The controller goes to STOP for 60 ms during a positioning run: ProviderState "
+        "STOP, IOPS bad, outputs zeroed; the drive keeps the last valid outputs (3.9), runs "
+        "on and its toggle echo keeps the old value. The only finding due is the STOP "
+        "after RUN, a should-level warning of IEC 61158-6-10",
+        seed=426006,
+    )
+    s.steps = (
+        [("wait", 100)]
+        + commissioning()
+        + [s.mark("run")]
+        + run_to(18_000)
+        + [("wait", 100)]
+    )
+
+    def stop(frame):
+        if "run" not in s.marks:
+            return
+        k = frame["cycle"] - s.marks["run"]
+        if 300 <= k < 360:
+            frame["stop"] = True
+            if k == 300:
+                tag(frame, "PN-RT-DS-002", "controller ProviderState STOP after RUN, during a "
+                                           "run, for 60 ms", level="should")
+    s.out_hooks.append(stop)
+    s.probes = [{"what": "IOPS bad and outputs zeroed while the controller is in STOP; the "
+                         "drive's toggle echo keeps the last valid control word's bit 13"}]
+    return s
+
+
 def main():
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
         os.path.dirname(os.path.abspath(__file__)), "..", "corpus", "planted")
     os.makedirs(out_dir, exist_ok=True)
-    for make in (clean, planted_protocol, planted_motion, idle_start, no_connect):
+    for make in (clean, planted_protocol, planted_motion, idle_start, no_connect,
+                 controller_stop):
         doc = make().build(out_dir)
         print(f"{doc['capture']}: {doc['frames']} frames, {len(doc['plants'])} plant(s)")
 

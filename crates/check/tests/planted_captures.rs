@@ -2,7 +2,8 @@
 //! and the bus description, no code of this project) with planted violations at known
 //! frames (`corpus/planted/*.truth.json`). Checked through the same path as `drivespec
 //! check`, every plant is found with its requirement at its frame (100 % recall) and
-//! nothing else is reported (no false alarm); a recording without plants passes.
+//! nothing else is reported (no false alarm); a recording without plants passes, one with
+//! only should-level plants passes with warnings.
 //!
 //! The second test runs the generator again (when python3 with scapy is installed; with
 //! `DRIVESPEC_REQUIRE_SCAPY` set a missing scapy fails instead of skipping) and compares
@@ -132,7 +133,7 @@ fn score(t: &Truth, r: &Report) -> (Vec<String>, Vec<String>) {
 fn every_plant_is_found_at_its_frame_and_nothing_else() {
     let spec = Spec::builtin().unwrap();
     let all = truths(&dir());
-    assert!(all.len() >= 5, "{} truth files", all.len());
+    assert!(all.len() >= 6, "{} truth files", all.len());
     let (mut plants, mut found, mut false_alarms) = (0usize, 0usize, Vec::new());
     let mut problems = Vec::new();
     for (_, t) in &all {
@@ -180,11 +181,15 @@ fn every_plant_is_found_at_its_frame_and_nothing_else() {
             ));
         }
         false_alarms.extend(false_here);
-        if t.plants.is_empty() {
-            assert_eq!(r.verdict, Verdict::Pass, "{}: {}", t.capture, t.description);
+        // No plant: PASS (exit 0); only should-level plants: PASS with warnings (exit 0).
+        let want = if t.plants.iter().any(|p| p.level == "must") {
+            Verdict::Fail
+        } else if t.plants.iter().any(|p| p.kind == "violation") {
+            Verdict::Warn
         } else {
-            assert_eq!(r.verdict, Verdict::Fail, "{}", t.capture);
-        }
+            Verdict::Pass
+        };
+        assert_eq!(r.verdict, want, "{}: {}", t.capture, t.description);
     }
     eprintln!(
         "planted recordings: {} files, {found} of {plants} plants found at their frame, {} false alarm(s)",
