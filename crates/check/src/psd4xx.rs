@@ -72,6 +72,8 @@ pub const CHECKED: &[&str] = &[
     "PSD-REC-007",
     "PSD-REC-008",
     "PSD-REC-009",
+    "PSD-VEL-001",
+    "PSD-VEL-002",
 ];
 
 /// Options of the PSD4xx checks.
@@ -83,6 +85,12 @@ pub struct PsdOptions {
     pub lag_cycles: u64,
     /// Input images within which a PKW command must be answered.
     pub pkw_cycles: u64,
+    /// Percent by which a speed may exceed the fastest the model allows before it is a
+    /// violation (PSD-VEL-001/002): a measured speed overshoots a little.
+    pub speed_slack_percent: u64,
+    /// Time (µs) added to the interval between two input images when the position change
+    /// between them is judged: capture time stamps jitter, and frames bunch after a delay.
+    pub jump_slack_us: u64,
 }
 
 impl Default for PsdOptions {
@@ -91,6 +99,8 @@ impl Default for PsdOptions {
             model: None,
             lag_cycles: 20,
             pkw_cycles: 2000,
+            speed_slack_percent: 10,
+            jump_slack_us: 4000,
         }
     }
 }
@@ -120,27 +130,59 @@ mod par {
     pub const UPPER_LIMIT: u16 = 42;
     pub const LOWER_LIMIT: u16 = 43;
     pub const WINDOW: u16 = 44;
+    pub const POSITIONING_SPEED: u16 = 53;
+    pub const MANUAL_SPEED: u16 = 56;
     pub const COMMAND: u16 = 96;
+
+    /// Whether an accepted write of `pnu` may change the actual position at once (4.7:
+    /// par 3 references it, par 37–41 recalculate it, par 96 restores or resets).
+    pub fn moves_actual(pnu: u16) -> bool {
+        matches!(pnu, ACTUAL | 37..=41 | COMMAND)
+    }
 }
 
 /// A relation that has failed for some input images.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 struct Streak {
-    since: Option<(u64, Where)>,
+    /// Input images seen, where and the image bytes when it started failing.
+    since: Option<(u64, Where, Vec<u8>)>,
     reported: bool,
 }
 
+/// Where a condition started that held too long: the violation is reported there.
+#[derive(Debug, Clone)]
+struct Started {
+    at: Where,
+    bytes: Vec<u8>,
+}
+
+/// Evidence of a condition that started at `start` and still held at `at`.
+fn held(start: &Started, at: Where) -> Evidence {
+    Evidence::bytes(&start.bytes).with("still_at", at.to_string())
+}
+
 impl Streak {
-    /// Updates the streak; true when it just exceeded `bound` images.
-    fn update(&mut self, failing: bool, n: u64, at: Where, bound: u64) -> Option<Where> {
+    /// Updates the streak with the image `bytes` at `at`; gives where the streak started
+    /// when it just exceeded `bound` images.
+    fn update(
+        &mut self,
+        failing: bool,
+        n: u64,
+        at: Where,
+        bytes: &[u8],
+        bound: u64,
+    ) -> Option<Started> {
         if !failing {
             *self = Streak::default();
             return None;
         }
-        let (start, w) = *self.since.get_or_insert((n, at));
-        if !self.reported && n.saturating_sub(start) >= bound {
+        let (start, w, b) = self.since.get_or_insert_with(|| (n, at, bytes.to_vec()));
+        if !self.reported && n.saturating_sub(*start) >= bound {
             self.reported = true;
-            return Some(w);
+            return Some(Started {
+                at: *w,
+                bytes: b.clone(),
+            });
         }
         None
     }
@@ -187,13 +229,24 @@ pub struct PsdDrive<'s> {
     window_state: bool,
     /// A transferred target beyond the limits, waiting for status bit 12: (image count then,
     /// where, target, the limit it exceeds).
-    bad_target: Option<(u64, Where, i32, i64)>,
+    bad_target: Option<(u64, Started, i32, i64)>,
     /// Checks already reported as undecidable on this drive (each once).
     undecided: Vec<&'static str>,
     prio_state: bool,
-    abort_pending: Option<(u64, Where)>,
+    /// The release withdrawn during a positioning run: (input images then, where).
+    abort_pending: Option<(u64, Started)>,
     spm_state: bool,
     records: BTreeMap<u16, Vec<u8>>,
+    /// The fastest any run of this drive may be (rpm): the largest par 53 or 56 of its
+    /// model, of every model when the model is unknown (3.4).
+    max_rpm: Option<i64>,
+    /// The previous input image's actual position and capture time.
+    last_actual: Option<(i32, u64)>,
+    /// A speed above the limit is shown (reported once per stretch).
+    too_fast: bool,
+    /// Input images up to which a change of the actual position is excused: a write that
+    /// moves it (par 3, 37–41, 96) was just accepted.
+    excused_until: u64,
     timeline: Timeline,
     /// The oracle's clock: (capture time of the latest event, oracle time then).
     clock: Option<(u64, u64)>,
@@ -239,6 +292,19 @@ impl<'s> PsdDrive<'s> {
                     .map_or_else(|| format!("bit {b}"), |x| x.name.clone())
             })
             .collect();
+        let models: Vec<&DeviceModel> = match model {
+            Some(m) => vec![m],
+            None => family.models.iter().collect(),
+        };
+        let max_rpm = [par::POSITIONING_SPEED, par::MANUAL_SPEED]
+            .iter()
+            .filter_map(|n| rules.parameter(u32::from(*n)))
+            .flat_map(|p| {
+                models
+                    .iter()
+                    .filter_map(|m| family.resolve(p, Some(m)).range.and_then(|r| r.max()))
+            })
+            .max();
         PsdDrive {
             label: label.to_owned(),
             family,
@@ -265,6 +331,10 @@ impl<'s> PsdDrive<'s> {
             abort_pending: None,
             spm_state: false,
             records: BTreeMap::new(),
+            max_rpm,
+            last_actual: None,
+            too_fast: false,
+            excused_until: 0,
             timeline: Timeline::new(label, names),
             clock: None,
         }
@@ -326,7 +396,7 @@ impl<'s> PsdDrive<'s> {
         let was = prev.filter(|p| p.control & bit::TRANSFER != 0);
         if transfer && was.is_none_or(|p| p.target != out.target) {
             self.target = Some((out.target, self.inputs));
-            self.transferred(rec, at, out.target);
+            self.transferred(rec, at, bytes, out.target);
         }
         if self.last_pkw_out != Some(out.pkw) {
             self.pkw_command(rec, at, bytes, out.pkw);
@@ -370,7 +440,13 @@ impl<'s> PsdDrive<'s> {
         let running = self.inp.is_some_and(|i| i.status & bit::RUNNING != 0);
         let manual = p & (bit::MANUAL_UP | bit::MANUAL_DOWN) != 0;
         if p & bit::RELEASE != 0 && control & bit::RELEASE == 0 && running && !manual {
-            self.abort_pending = Some((self.inputs, at));
+            self.abort_pending = Some((
+                self.inputs,
+                Started {
+                    at,
+                    bytes: bytes.to_vec(),
+                },
+            ));
         }
         if control & bit::RELEASE != 0 {
             self.abort_pending = None;
@@ -449,67 +525,76 @@ impl<'s> PsdDrive<'s> {
         if let Some(out) = self.out {
             let want = out.control & bit::TOGGLE != 0;
             let have = inp.status & bit::TOGGLE_ECHO != 0;
-            if let Some(w) = self.toggle.update(want != have, n, at, lag) {
+            if let Some(w) = self.toggle.update(want != have, n, at, bytes, lag) {
                 self.violation(
                     rec,
                     "PSD-CTL-13-001",
-                    at,
+                    w.at,
                     format!(
-                        "status bit 2 = {} does not echo control bit 13 = {} since {w} ({lag} input images)",
+                        "status bit 2 = {} does not echo control bit 13 = {} from here to {at} ({lag} input images)",
                         u8::from(have),
                         u8::from(want)
                     ),
-                    ev().with("control", format!("{:#06x}", out.control)),
+                    held(&w, at).with("control", format!("{:#06x}", out.control)),
                 );
             }
         }
         // PSD-STS-6-SET-1 / PSD-STS-6-RESET-1: the running bit follows the speed.
         let running = inp.status & bit::RUNNING != 0;
-        if let Some(w) = self
-            .speed_without_run
-            .update(!running && inp.speed != 0, n, at, lag)
+        if let Some(w) =
+            self.speed_without_run
+                .update(!running && inp.speed != 0, n, at, bytes, lag)
         {
             self.violation(
                 rec,
                 "PSD-STS-6-SET-1",
-                at,
+                w.at,
                 format!(
-                    "speed {} rpm with status bit 6 (running) clear since {w}",
+                    "speed {} rpm with status bit 6 (running) clear from here to {at} ({lag} input images)",
                     inp.speed
                 ),
-                ev(),
+                held(&w, at).with("speed", inp.speed),
             );
         }
-        if let Some(w) =
-            self.run_without_speed
-                .update(running && inp.speed == 0, n, at, lag.saturating_mul(5))
-        {
+        if let Some(w) = self.run_without_speed.update(
+            running && inp.speed == 0,
+            n,
+            at,
+            bytes,
+            lag.saturating_mul(5),
+        ) {
             self.violation(
                 rec,
                 "PSD-STS-6-RESET-1",
-                at,
-                format!("status bit 6 (running) set at speed 0 since {w}"),
-                ev(),
+                w.at,
+                format!(
+                    "status bit 6 (running) set at speed 0 from here to {at} ({} input images)",
+                    lag.saturating_mul(5)
+                ),
+                held(&w, at),
             );
         }
         // PSD-STS-5-SET-1: a positioning run aborted by withdrawing the release sets bit 5.
-        if let Some((since, w)) = self.abort_pending {
-            if inp.status & (bit::ABORTED | bit::TARGET_REACHED) != 0 {
-                self.abort_pending = None;
-            } else if n.saturating_sub(since) >= lag && !running {
-                self.abort_pending = None;
+        if let Some((since, w)) = self.abort_pending.take() {
+            // Bit 5 (or the target reached after all) ends the wait.
+            let shown = inp.status & (bit::ABORTED | bit::TARGET_REACHED) != 0;
+            let stopped = n.saturating_sub(since) >= lag && !running;
+            if !shown && stopped {
                 self.violation(
                     rec,
                     "PSD-STS-5-SET-1",
-                    at,
-                    format!("the release was withdrawn during a run at {w}; the drive stopped without status bit 5"),
-                    ev(),
+                    w.at,
+                    format!("the release is withdrawn here during a run; the drive stopped at {at} without status bit 5"),
+                    held(&w, at).with("status", format!("{:#06x}", inp.status)),
                 );
+            } else if !shown {
+                self.abort_pending = Some((since, w));
             }
         }
         self.window_check(rec, at, &inp, bytes);
-        self.bad_target_check(rec, at, &inp, bytes);
+        self.bad_target_check(rec, at, &inp);
         self.limit_check(rec, at, &inp, bytes);
+        self.speed_check(rec, at, &inp, bytes);
         self.pkw_answer(rec, at, bytes, inp.pkw);
         self.inp = Some(inp);
     }
@@ -544,6 +629,18 @@ impl<'s> PsdDrive<'s> {
             max.saturating_mul(scale),
             "par 44 not seen: the largest window (3.3 par 44)",
         ))
+    }
+
+    /// The values par 44 surely accepts at the scaling the capture shows: 1 up to the
+    /// delivery-scaling maximum (100, 3.3) times the resolution factor par 39 / par 38
+    /// (rounded down: "the maximum setting value changes according to the same factor as
+    /// the resolution"); none while the scaling was not seen.
+    fn window_range(&self, p: &drivespec_spec::Parameter) -> Option<(i64, i64)> {
+        let range = self.family.resolve(p, self.model).range?;
+        let n = self.known.get(&par::NUMERATOR)?.value;
+        let d = self.known.get(&par::DENOMINATOR)?.value;
+        let hi = range.max()?.checked_mul(d)?.checked_div(n)?;
+        Some((range.min()?, hi))
     }
 
     /// PSD-PAR-44-001: bit 0 only inside the positioning window around the target in force,
@@ -600,7 +697,7 @@ impl<'s> PsdDrive<'s> {
 
     /// A target transferred: beyond the limits in force (par 42/43), status bit 12 is due
     /// (3.6 bit 12, PSD-STS-12-SET-1).
-    fn transferred(&mut self, rec: &mut Recorder, at: Where, target: i32) {
+    fn transferred(&mut self, rec: &mut Recorder, at: Where, bytes: &[u8], target: i32) {
         self.bad_target = None;
         let (Some(upper), Some(lower)) = (
             self.known.get(&par::UPPER_LIMIT).map(|k| k.value),
@@ -615,24 +712,31 @@ impl<'s> PsdDrive<'s> {
             return;
         };
         let t = i64::from(target);
-        if t > upper {
-            self.bad_target = Some((self.inputs, at, target, upper));
+        let limit = if t > upper {
+            upper
         } else if t < lower {
-            self.bad_target = Some((self.inputs, at, target, lower));
-        }
+            lower
+        } else {
+            return;
+        };
+        let start = Started {
+            at,
+            bytes: bytes.to_vec(),
+        };
+        self.bad_target = Some((self.inputs, start, target, limit));
     }
 
     /// PSD-STS-12-SET-1: after a target beyond the limits, bit 12 within the lag.
-    fn bad_target_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
-        let Some((since, w, target, limit)) = self.bad_target else {
+    fn bad_target_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input) {
+        let Some((since, w, target, limit)) = self.bad_target.take() else {
             return;
         };
         if inp.status & bit::BAD_TARGET != 0 {
-            self.bad_target = None;
             return;
         }
-        if self.inputs.saturating_sub(since) >= self.options.lag_cycles {
-            self.bad_target = None;
+        if self.inputs.saturating_sub(since) < self.options.lag_cycles {
+            self.bad_target = Some((since, w, target, limit));
+        } else {
             let running = if inp.status & bit::RUNNING != 0 {
                 ", and the drive is running"
             } else {
@@ -641,11 +745,11 @@ impl<'s> PsdDrive<'s> {
             self.violation(
                 rec,
                 "PSD-STS-12-SET-1",
-                at,
+                w.at,
                 format!(
-                    "target {target} transferred at {w} lies beyond the limit {limit}; status bit 12 (incorrect target value) is not set{running}"
+                    "target {target} transferred here lies beyond the limit {limit}; status bit 12 (incorrect target value) is not set at {at}{running}"
                 ),
-                Evidence::bytes(bytes)
+                held(&w, at)
                     .with("target", target)
                     .with("limit", limit)
                     .with("status", format!("{:#06x}", inp.status)),
@@ -663,28 +767,128 @@ impl<'s> PsdDrive<'s> {
         let standstill = inp.status & bit::RUNNING == 0;
         if let Some(upper) = self.known.get(&par::UPPER_LIMIT).map(|k| k.value) {
             let bad = standstill && inp.status & bit::UPPER_LIMIT != 0 && actual < upper - window;
-            if let Some(w) = self.upper.update(bad, n, at, lag) {
+            if let Some(w) = self.upper.update(bad, n, at, bytes, lag) {
                 self.violation(
                     rec,
                     "PSD-STS-14-RESET-1",
-                    at,
-                    format!("status bit 14 (upper limit) set at {actual}, inside the limit {upper} since {w}"),
-                    Evidence::bytes(bytes).with("actual", actual).with("upper_limit", upper),
+                    w.at,
+                    format!("status bit 14 (upper limit) set at {actual}, inside the limit {upper}, from here to {at}"),
+                    held(&w, at).with("actual", actual).with("upper_limit", upper),
                 );
             }
         }
         if let Some(lower) = self.known.get(&par::LOWER_LIMIT).map(|k| k.value) {
             let bad = standstill && inp.status & bit::LOWER_LIMIT != 0 && actual > lower + window;
-            if let Some(w) = self.lower.update(bad, n, at, lag) {
+            if let Some(w) = self.lower.update(bad, n, at, bytes, lag) {
                 self.violation(
                     rec,
                     "PSD-STS-15-RESET-1",
-                    at,
-                    format!("status bit 15 (lower limit) set at {actual}, inside the limit {lower} since {w}"),
-                    Evidence::bytes(bytes).with("actual", actual).with("lower_limit", lower),
+                    w.at,
+                    format!("status bit 15 (lower limit) set at {actual}, inside the limit {lower}, from here to {at}"),
+                    held(&w, at).with("actual", actual).with("lower_limit", lower),
                 );
             }
         }
+    }
+
+    /// Increments per rotation at the scaling the capture shows (4.8: 400 × par 39 / par
+    /// 38), when both factors were seen.
+    fn increments_per_rotation(&self) -> Option<f64> {
+        let scaling = &self.family.psd4xx()?.positioning.scaling;
+        let n = self.known.get(&par::NUMERATOR)?.value;
+        let d = self.known.get(&par::DENOMINATOR)?.value;
+        scaling
+            .increments_per_rotation(n, d)
+            .filter(|i| i.is_finite() && *i > 0.0)
+    }
+
+    /// Whether a write that moves the actual position is in force or just accepted (PKW
+    /// command standing, record write unanswered, or answered within the lag).
+    fn actual_may_move(&self) -> bool {
+        let pkw_write = self.command.is_some_and(|c| {
+            par::moves_actual(c.req.pnu)
+                && self
+                    .pkw()
+                    .command_info(c.req.ak)
+                    .is_some_and(|i| i.op == PkwOp::Write)
+        });
+        pkw_write
+            || self.records.keys().any(|k| par::moves_actual(*k))
+            || self.inputs <= self.excused_until
+    }
+
+    /// PSD-VEL-001 / PSD-VEL-002 (4.3 with 3.4 par 53, 56): no run is faster than the
+    /// fastest speed the model can be set to, with [`PsdOptions::speed_slack_percent`] —
+    /// neither the current speed the drive reports nor the speed its actual position
+    /// implies between two input images (over their capture interval plus
+    /// [`PsdOptions::jump_slack_us`], at the scaling the capture shows; the shortest way
+    /// round a wrap of the 32-bit value; excused while a write that moves the actual
+    /// position is in force). Reported once per stretch, as a manual run (PSD-VEL-001) when
+    /// the control word in force starts one, else as a positioning run (PSD-VEL-002).
+    fn speed_check(&mut self, rec: &mut Recorder, at: Where, inp: &Input, bytes: &[u8]) {
+        let prev = self.last_actual.take();
+        self.last_actual = at.time.map(|t| (inp.actual, t));
+        let Some(max) = self.max_rpm else {
+            return;
+        };
+        let slack = self.options.speed_slack_percent;
+        let limit = max.saturating_mul(i64::try_from(slack).unwrap_or(0).saturating_add(100)) / 100;
+        let who = self.model.map_or_else(
+            || "the fastest PSD4xx model (model unknown)".to_owned(),
+            |m| m.name.clone(),
+        );
+        let speed = i64::from(inp.speed);
+        let mut finding = None;
+        if speed.abs() > limit {
+            finding = Some((
+                format!(
+                    "current speed {speed} rpm is above {limit} rpm: {who} runs at most {max} rpm (3.4 par 53, 56), {slack} % allowed"
+                ),
+                Evidence::bytes(bytes)
+                    .with("speed", speed)
+                    .with("limit_rpm", limit),
+            ));
+        } else if let (Some((p, t0)), Some(t1)) = (prev, at.time) {
+            let moved = (i64::from(inp.actual) - i64::from(p)).abs();
+            let moved = moved.min((1i64 << 32) - moved);
+            let dt = t1.saturating_sub(t0);
+            match self.increments_per_rotation() {
+                _ if moved == 0 || self.actual_may_move() => {}
+                Some(ipr) => {
+                    let window = dt.saturating_add(self.options.jump_slack_us) as f64;
+                    let allowed = (limit as f64 * ipr * window / 60e6).ceil() + 2.0;
+                    if moved as f64 > allowed {
+                        let rpm = moved as f64 * 60e6 / (ipr * dt.max(1) as f64);
+                        finding = Some((
+                            format!(
+                                "actual position moved {moved} increments ({p} to {}) in {dt} µs: about {rpm:.0} rpm at {ipr:.0} increments per rotation, above {limit} rpm ({who}: at most {max} rpm, 3.4 par 53, 56, {slack} % allowed)",
+                                inp.actual
+                            ),
+                            Evidence::bytes(bytes)
+                                .with("previous_actual", p)
+                                .with("actual", inp.actual)
+                                .with("interval_us", dt)
+                                .with("allowed_increments", allowed),
+                        ));
+                    }
+                }
+                None => self.undecided(
+                    rec,
+                    "PSD-VEL-002",
+                    at,
+                    "the actual position changes, but the scaling (par 38, 39) was not seen: increments per rotation unknown",
+                ),
+            }
+        }
+        let manual = self.out.is_some_and(|o| {
+            o.control & bit::RELEASE != 0 && o.control & (bit::MANUAL_UP | bit::MANUAL_DOWN) != 0
+        });
+        let id = if manual { "PSD-VEL-001" } else { "PSD-VEL-002" };
+        let bad = finding.is_some();
+        if let (Some((message, ev)), false) = (finding, self.too_fast) {
+            self.violation(rec, id, at, message, ev);
+        }
+        self.too_fast = bad;
     }
 
     // ------------------------------------------------------------------ PKW
@@ -757,14 +961,15 @@ impl<'s> PsdDrive<'s> {
                     self.violation(
                         rec,
                         "PSD-PKW-002",
-                        at,
+                        c.at,
                         format!(
-                            "no response to `{}` (sent at {}) within {} input images",
+                            "no response to `{}`, sent here, within {} input images (until {at})",
                             self.pkw().describe_request(&c.req),
-                            c.at,
                             self.options.pkw_cycles
                         ),
-                        pkw_ev(),
+                        pkw_ev()
+                            .with("command", self.pkw().describe_request(&c.req))
+                            .with("still_at", at.to_string()),
                     );
                 }
             }
@@ -965,6 +1170,9 @@ impl<'s> PsdDrive<'s> {
         value: i64,
         ev: Evidence,
     ) {
+        if par::moves_actual(pnu) {
+            self.excused_until = self.inputs.saturating_add(self.options.lag_cycles);
+        }
         if pnu == par::COMMAND {
             // Par. 96 restores, resets or saves: every value may change.
             self.known.clear();
@@ -981,7 +1189,7 @@ impl<'s> PsdDrive<'s> {
                 Some("PSD-PKW-023")
             } else if e == codes.read_only {
                 Some("PSD-PKW-024")
-            } else if e == codes.out_of_range {
+            } else if e == codes.out_of_range && !self.another_model_allows(pnu, value) {
                 Some("PSD-PKW-025")
             } else {
                 None
@@ -1006,6 +1214,23 @@ impl<'s> PsdDrive<'s> {
         if !live {
             self.known.insert(pnu, Known { value, at });
         }
+    }
+
+    /// With the model unknown, whether some model of the family accepts `value` for a
+    /// parameter whose range depends on the model (3.4): the oracle stands for one model
+    /// only, so its refusal proves nothing then.
+    fn another_model_allows(&self, pnu: u16, value: i64) -> bool {
+        let Some(p) = self.rules.parameter(u32::from(pnu)) else {
+            return false;
+        };
+        self.model.is_none()
+            && p.range_model
+            && self.family.models.iter().any(|m| {
+                self.family
+                    .resolve(p, Some(m))
+                    .range
+                    .is_some_and(|r| r.contains(value))
+            })
     }
 
     /// Values the drive recalculates after an accepted write of `pnu` (4.7 notes 3–6 and
@@ -1083,6 +1308,9 @@ impl<'s> PsdDrive<'s> {
             )
         } else if e == codes.out_of_range {
             let outside = match (p, value) {
+                (Some(p), Some(v)) if write && p.number == u32::from(par::WINDOW) => {
+                    self.window_range(p).is_none_or(|(lo, hi)| v < lo || v > hi)
+                }
                 (Some(p), Some(v)) if write => {
                     p.range_note.is_some()
                         || (p.range_model && self.model.is_none())

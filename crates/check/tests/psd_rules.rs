@@ -1,7 +1,8 @@
 //! The PSD4xx plausibility rules on hand-made image sequences (bus description 3.6, 4.7):
 //! status bit 0 far from the target during and after a run, the positioning window when par
 //! 44 was not seen, a target beyond the limits without status bit 12, re-referencing by a
-//! write of par 3, and what cannot be decided.
+//! write of par 3, speeds and position jumps beyond the fastest model (4.3, 3.4), and what
+//! cannot be decided.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -201,4 +202,116 @@ fn a_target_without_known_limits_is_inconclusive() {
         .inconclusive
         .iter()
         .any(|i| i.requirement == "PSD-STS-12-SET-1"));
+}
+
+/// The delivery scaling (par 38 = par 39 = 400: 400 increments per rotation), as read.
+fn delivery_scaling(b: &mut Bench<'_>) {
+    b.read(38, Width::Word, 400);
+    b.read(39, Width::Word, 400);
+}
+
+#[test]
+fn a_position_jump_faster_than_any_model_is_a_violation() {
+    let spec = Spec::builtin().unwrap();
+    let mut b = Bench::new(&spec);
+    delivery_scaling(&mut b);
+    // 1000 rpm (the fastest model) is about 6.7 increments per ms: 30 per ms is allowed
+    // with the slack (+10 %, 4 ms), 30,000 is not.
+    b.cycles(10, 0x10, 40_000, RUNNING, 1000, 1000);
+    b.cycles(1, 0x10, 40_000, RUNNING, 1030, 1000);
+    b.cycles(1, 0x10, 40_000, RUNNING, 31_030, 1000);
+    b.cycles(10, 0x10, 40_000, RUNNING, 31_037, 1000);
+    let jump_frame = 2 + 2 * 12;
+    let r = b.report();
+    assert_eq!(count(&r, "PSD-VEL-002"), 1, "{:#?}", r.violations);
+    assert_eq!(r.violations[0].at.frame, Some(jump_frame));
+    assert!(r.violations[0].message.contains("30000 increments"));
+    assert_eq!(r.inconclusive_count, 0, "{:#?}", r.inconclusive);
+}
+
+#[test]
+fn a_position_wrapping_round_the_32_bit_value_moves_the_short_way() {
+    let spec = Spec::builtin().unwrap();
+    let mut b = Bench::new(&spec);
+    delivery_scaling(&mut b);
+    b.cycles(3, 0x10, 0, RUNNING, i32::MAX - 2, 300);
+    b.cycles(3, 0x10, 0, RUNNING, i32::MIN + 2, 300);
+    let r = b.report();
+    assert_eq!(r.violation_count, 0, "{:#?}", r.violations);
+}
+
+#[test]
+fn writing_par_3_excuses_the_jump_of_the_actual_value() {
+    let spec = Spec::builtin().unwrap();
+    let mut b = Bench::new(&spec);
+    delivery_scaling(&mut b);
+    b.cycles(10, 0x00, 0, 0, 10_000, 0);
+    b.write(3, Width::Dword, 50_000);
+    b.cycles(10, 0x00, 0, 0, 50_000, 0);
+    let r = b.report();
+    assert_eq!(r.violation_count, 0, "{:#?}", r.violations);
+}
+
+#[test]
+fn a_speed_above_the_fastest_model_is_a_violation_once_per_stretch() {
+    let spec = Spec::builtin().unwrap();
+    let mut b = Bench::new(&spec);
+    // Model unknown: 1000 rpm (PSD 422/432-8V, 3.4 par 53) + 10 % is the limit.
+    b.cycles(10, 0x10, 0, RUNNING, 0, 1100);
+    b.cycles(10, 0x10, 0, RUNNING, 0, 1200);
+    b.cycles(10, 0x10, 0, RUNNING, 0, 900);
+    // A manual run (control bits 0 and 4) too fast: par 56's requirement.
+    b.cycles(10, 0x11, 0, RUNNING, 0, -1500);
+    let r = b.report();
+    assert_eq!(count(&r, "PSD-VEL-002"), 1, "{:#?}", r.violations);
+    assert_eq!(count(&r, "PSD-VEL-001"), 1, "{:#?}", r.violations);
+    assert_eq!(r.violations[0].at.frame, Some(22));
+    // Without the scaling, the position change cannot be judged: said once.
+    assert_eq!(r.inconclusive_count, 0);
+    let mut b = Bench::new(&spec);
+    b.cycles(5, 0x10, 0, RUNNING, 0, 100);
+    b.cycles(5, 0x10, 0, RUNNING, 90_000, 100);
+    let r = b.report();
+    assert_eq!(r.violation_count, 0, "{:#?}", r.violations);
+    assert!(r
+        .inconclusive
+        .iter()
+        .any(|i| i.requirement == "PSD-VEL-002"));
+}
+
+/// With the model unknown, a write some model of the family accepts is no violation, even
+/// where the reference model standing in for the drive (the family's first) refuses it.
+#[test]
+fn an_accepted_write_in_another_models_range_is_no_violation() {
+    let spec = Spec::builtin().unwrap();
+    let rules = Arc::new(Rules::from_spec(&spec).unwrap());
+    let family = spec.family(FamilyId::Psd4xx);
+    let oracle = drivespec_psd4xx::model::Drive::new(
+        &spec,
+        drivespec_psd4xx::model::DriveConfig::new(&family.models[0].id),
+    )
+    .unwrap();
+    let drive = PsdDrive::new(
+        "drive",
+        family,
+        rules.clone(),
+        None,
+        Some(oracle),
+        PsdOptions::default(),
+    );
+    let rec = Recorder::new(Arc::new(Catalog::new(&spec).unwrap()), "psd4xx", None);
+    let mut b = Bench {
+        rules,
+        drive,
+        rec,
+        frame: 0,
+    };
+    b.cycles(2, 0x00, 0, 0, 0, 0);
+    // 900 rpm: beyond the first model's par 53 (1..800), inside PSD 422/432-8V's (1..1000).
+    b.write(53, Width::Word, 900);
+    // 5000 rpm: no model has it.
+    b.write(53, Width::Word, 5000);
+    let r = b.report();
+    assert_eq!(count(&r, "PSD-PKW-025"), 1, "{:#?}", r.violations);
+    assert!(r.violations[0].message.contains("5000"));
 }
