@@ -59,7 +59,7 @@ struct PendingSet {
 /// The event recognisers of a PROFINET capture.
 #[derive(Debug, Clone)]
 pub struct PnEvents {
-    names: PnioNames,
+    names: &'static PnioNames,
     sets: VecDeque<PendingSet>,
     stations: HashMap<String, [u8; 6]>,
     conflicts: HashSet<String>,
@@ -120,7 +120,7 @@ fn event(rec: &mut Recorder, id: &str, subject: &str, at: Where, message: String
 
 impl PnEvents {
     /// Recognisers naming PNIOStatus values and alarm types with `names`.
-    pub fn new(names: PnioNames) -> PnEvents {
+    pub fn new(names: &'static PnioNames) -> PnEvents {
         PnEvents {
             names,
             sets: VecDeque::new(),

@@ -62,8 +62,15 @@ fn named(value: u8, name: Option<&String>) -> String {
 }
 
 impl PnioNames {
+    /// The names file, read once per process (every checker of a run shares it).
+    pub fn shared() -> Result<&'static PnioNames, NamesError> {
+        static NAMES: std::sync::OnceLock<Result<PnioNames, NamesError>> =
+            std::sync::OnceLock::new();
+        NAMES.get_or_init(PnioNames::load).as_ref().map_err(Clone::clone)
+    }
+
     /// Reads the names file.
-    pub fn load() -> Result<PnioNames, NamesError> {
+    fn load() -> Result<PnioNames, NamesError> {
         let f: NamesFile = toml::from_str(NAMES).map_err(|e| NamesError(e.to_string()))?;
         Ok(PnioNames {
             code: table(f.error_code),

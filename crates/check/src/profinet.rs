@@ -366,7 +366,7 @@ impl<'s> PnChecker<'s> {
             cyclic_frames: 0,
             connects_without_psd: 0,
             first_without_psd: None,
-            pn_events: PnEvents::new(PnioNames::load()?),
+            pn_events: PnEvents::new(PnioNames::shared()?),
             last_time: None,
             ended: HashMap::new(),
             options,
