@@ -631,6 +631,7 @@ fn build_report(
         coverage,
         coverage_summary,
         stale_expectations: stale,
+        plot_units: suites.iter().filter_map(|s| s.plot_units()).collect(),
         timing: None,
     }
 }
