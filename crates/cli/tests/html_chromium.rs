@@ -1,8 +1,8 @@
 //! Every HTML report the real binary writes loads in headless Chromium without a console
 //! message and with the elements a reader needs: `conform` passing (plots), failing (an
 //! adapter with gaps: the failure list, plots with the failing cycle marked) and stopped by
-//! `--timeout`, `fuzz`, and `check` on recordings of `corpus/captures/` (violations,
-//! timelines).
+//! `--timeout`, `fuzz` with findings (the same adapter), and `check` on recordings of
+//! `corpus/captures/` (violations, timelines).
 //!
 //! How a page is judged: `chromium --headless --dump-dom --enable-logging=stderr --v=0`
 //! loads it from a file; Chromium logs every console message (a `console.*` call, an
@@ -126,15 +126,19 @@ fn reports(dir: &Path) -> Vec<Page> {
         &[
             "fuzz",
             "psd4xx",
+            "--dut",
+            &adapter,
             "--seed",
             "7",
             "--iterations",
-            "100",
+            "10",
+            "--minimize-runs",
+            "1",
             "--quiet",
             "--out",
             &d("fuzz"),
         ],
-        0,
+        1,
     );
     drivespec(
         &[
@@ -186,7 +190,11 @@ fn reports(dir: &Path) -> Vec<Page> {
         },
         Page {
             file: dir.join("fuzz/fuzz.html"),
-            must: &["<section id=\"summary\">", "<h2>Fuzzing</h2>"],
+            must: &[
+                "<section id=\"summary\">",
+                "<h2>Fuzzing</h2>",
+                "<ol class=\"fail-list\">",
+            ],
             must_not: &[],
         },
         Page {

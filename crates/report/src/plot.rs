@@ -298,7 +298,7 @@ pub fn svg(note: &str, units: Units<'_>) -> Option<String> {
         let nudge = if anchor == "end" { -4.0 } else { 4.0 };
         let _ = write!(
             out,
-            "<g class=\"failure-marker\"><line x1=\"{x:.1}\" y1=\"{pos_top:.0}\" x2=\"{x:.1}\" y2=\"{:.0}\" {FAILURE}/><text x=\"{:.1}\" y=\"{:.0}\" fill=\"#d00000\" text-anchor=\"{anchor}\">{}</text><title>{}</title></g>",
+            "<g class=\"failure-marker\"><line x1=\"{x:.1}\" y1=\"{pos_top:.0}\" x2=\"{x:.1}\" y2=\"{:.0}\" {FAILURE} stroke-dasharray=\"6 3\" stroke-opacity=\"0.7\"/><text x=\"{:.1}\" y=\"{:.0}\" fill=\"#d00000\" text-anchor=\"{anchor}\">{}</text><title>{}</title></g>",
             strip_top + 12.0,
             x + nudge,
             pos_top + 12.0,
