@@ -408,7 +408,8 @@ fn svg(t: &Timeline) -> String {
         (1_000_000.0, "s")
     };
     let rel = |time: u64| time.saturating_sub(first.time) as f64 / scale;
-    let t1 = rel(last.time).max(1.0 / scale);
+    // At least one unit wide: a drive seen once is a point at the start.
+    let t1 = rel(last.time).max(1.0);
     let mut o = String::new();
     let _ = writeln!(
         o,
@@ -430,7 +431,8 @@ fn svg(t: &Timeline) -> String {
         if lo > hi {
             (0.0, 1.0)
         } else {
-            let pad = ((hi as f64 - lo as f64) * 0.05).max(1.0);
+            // A flat line sits mid-panel with whole-number ticks.
+            let pad = ((hi as f64 - lo as f64) * 0.05).max(2.0);
             (lo as f64 - pad, hi as f64 + pad)
         }
     };
@@ -453,8 +455,16 @@ fn svg(t: &Timeline) -> String {
         y: range(&mut t.samples.iter().map(|s| s.speed)),
         ..position
     };
-    let line = |o: &mut String, pts: Vec<(f64, f64)>, style: &str| {
-        if !pts.is_empty() {
+    // One sample is drawn as a dot, more as a line.
+    let line = |o: &mut String, pts: Vec<(f64, f64)>, style: &str| match pts.as_slice() {
+        [] => {}
+        [(x, y)] => {
+            let _ = writeln!(
+                o,
+                "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"2.5\" fill=\"none\" {style}/>"
+            );
+        }
+        _ => {
             let _ = writeln!(o, "{}", polyline(&pts, style));
         }
     };

@@ -208,7 +208,8 @@ pub fn svg(note: &str, units: Units<'_>) -> Option<String> {
             .iter()
             .flat_map(|s| std::iter::once(pick(s.reference)).chain(s.dut.map(pick)));
         let (lo, hi) = values.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
-        let pad = ((hi - lo) * 0.05).max(1.0);
+        // A flat line sits mid-panel with whole-number ticks.
+        let pad = ((hi - lo) * 0.05).max(2.0);
         let frame = Frame {
             left: LEFT,
             top: *top,
