@@ -1,13 +1,14 @@
 //! Reports for people and tools: a text summary, JSON (schema `drivespec-check/1`, crate
 //! README), JUnit XML (one test case per requirement checked) and a self-contained HTML page
-//! with a timeline plot (inline SVG) per positioning drive. Output size is bounded by the
+//! (a summary linking to each recording's violations, then per recording its violations, a
+//! timeline plot (inline SVG) per positioning drive, the requirements and the timing). Output size is bounded by the
 //! reports (violation listing cap, bounded timelines). Nothing here panics.
 
 use crate::report::{format_time, Observation, Report, Verdict, SCHEMA};
 use crate::timeline::Timeline;
 use drivespec_report::escape as xml;
 use drivespec_report::junit::{self as xml_junit, Case, Outcome, Problem, Suite};
-use drivespec_report::svg::polyline;
+use drivespec_report::svg::{legend, polyline, Frame, Key};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -377,147 +378,216 @@ pub fn junit(reports: &[Report]) -> String {
     .to_xml()
 }
 
-/// An SVG timeline: position and target, speed, the 16 status bits, violation marks.
+/// An SVG timeline (`<svg class="timeline">`, as wide as the page allows): a legend, the
+/// position and target and the speed over time with ticks and titled axes, the 16 status
+/// bits with their full names, and a red line at each violation.
 fn svg(t: &Timeline) -> String {
-    let (w, h_pos, h_speed, row) = (1000.0f64, 200.0f64, 120.0f64, 10.0f64);
-    let h_bits = row * 16.0;
-    let height = h_pos + h_speed + h_bits + 60.0;
+    let (Some(first), Some(last)) = (t.samples.first(), t.samples.last()) else {
+        return "<p class=\"muted\">no samples</p>\n".to_owned();
+    };
+    let names: Vec<String> = (0..16usize)
+        .map(|b| {
+            t.status_names
+                .get(b)
+                .map_or_else(|| format!("bit {b}"), |n| format!("{b} {n}"))
+        })
+        .collect();
+    // Room for the longest bit name (about 6 px a character) and the axes' tick labels.
+    let widest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    let left = (16.0 + 6.0 * widest as f64).clamp(100.0, 300.0);
+    let (w, row) = (1000.0f64.max(left + 500.0), 12.0f64);
+    let width = w - left - 15.0;
+    let (pos_top, pos_h, speed_top, speed_h) = (30.0, 180.0, 240.0, 110.0);
+    let bits_top = speed_top + speed_h + 48.0;
+    let height = bits_top + 16.0 * row + 10.0;
+    // Time since the first sample: ms for up to 10 s, s beyond.
+    let span_us = last.time.saturating_sub(first.time);
+    let (scale, unit) = if span_us <= 10_000_000 {
+        (1000.0, "ms")
+    } else {
+        (1_000_000.0, "s")
+    };
+    let rel = |time: u64| time.saturating_sub(first.time) as f64 / scale;
+    // At least one unit wide: a drive seen once is a point at the start.
+    let t1 = rel(last.time).max(1.0);
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{height}\" viewBox=\"0 0 {w} {height}\" font-family=\"sans-serif\" font-size=\"10\">"
+        "<svg class=\"timeline\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{height}\" viewBox=\"0 0 {w} {height}\" font-family=\"sans-serif\" font-size=\"11\">"
     );
-    let (Some(first), Some(last)) = (t.samples.first(), t.samples.last()) else {
-        o.push_str("<text x=\"10\" y=\"20\">no samples</text></svg>");
-        return o;
-    };
-    let t0 = first.time as f64;
-    let span = ((last.time as f64) - t0).max(1.0);
-    let left = 60.0;
-    let plot_w = w - left - 10.0;
-    let x = |time: u64| left + ((time as f64 - t0) / span) * plot_w;
+    o.push_str(&legend(
+        left,
+        14.0,
+        &[
+            (Key::Line(POSITION), "actual position"),
+            (Key::Line(TARGET), "target"),
+            (Key::Line(SPEED), "speed"),
+            (Key::Fill(BIT), "status bit set"),
+            (Key::Line(VIOLATION), "violation"),
+        ],
+    ));
     let range = |vals: &mut dyn Iterator<Item = i64>| {
-        let mut lo = i64::MAX;
-        let mut hi = i64::MIN;
-        for v in vals {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
+        let (lo, hi) = vals.fold((i64::MAX, i64::MIN), |(a, b), v| (a.min(v), b.max(v)));
         if lo > hi {
             (0.0, 1.0)
-        } else if lo == hi {
-            (lo as f64 - 1.0, hi as f64 + 1.0)
         } else {
-            (lo as f64, hi as f64)
+            // A flat line sits mid-panel with whole-number ticks.
+            let pad = ((hi as f64 - lo as f64) * 0.05).max(2.0);
+            (lo as f64 - pad, hi as f64 + pad)
         }
     };
-    let (plo, phi) = range(
-        &mut t
-            .samples
-            .iter()
-            .flat_map(|s| std::iter::once(s.actual).chain(s.target)),
-    );
-    let (slo, shi) = range(&mut t.samples.iter().map(|s| s.speed));
-    let y_pos = |v: i64| 10.0 + h_pos - ((v as f64 - plo) / (phi - plo)) * h_pos;
-    let y_speed = |v: i64| 20.0 + h_pos + h_speed - ((v as f64 - slo) / (shi - slo)) * h_speed;
-    let line = |o: &mut String, pts: Vec<(f64, f64)>, color: &str| {
-        if pts.is_empty() {
-            return;
-        }
-        let _ = writeln!(
-            o,
-            "{}",
-            polyline(&pts, &format!("stroke=\"{color}\" stroke-width=\"1\""))
-        );
+    let position = Frame {
+        left,
+        top: pos_top,
+        width,
+        height: pos_h,
+        x: (0.0, t1),
+        y: range(
+            &mut t
+                .samples
+                .iter()
+                .flat_map(|s| std::iter::once(s.actual).chain(s.target)),
+        ),
     };
-    let _ = writeln!(o, "<text x=\"2\" y=\"20\">position</text><text x=\"2\" y=\"32\">{phi:.0}</text><text x=\"2\" y=\"{:.0}\">{plo:.0}</text>", 10.0 + h_pos);
+    let speed = Frame {
+        top: speed_top,
+        height: speed_h,
+        y: range(&mut t.samples.iter().map(|s| s.speed)),
+        ..position
+    };
+    // One sample is drawn as a dot, more as a line.
+    let line = |o: &mut String, pts: Vec<(f64, f64)>, style: &str| match pts.as_slice() {
+        [] => {}
+        [(x, y)] => {
+            let _ = writeln!(
+                o,
+                "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"2.5\" fill=\"none\" {style}/>"
+            );
+        }
+        _ => {
+            let _ = writeln!(o, "{}", polyline(&pts, style));
+        }
+    };
+    o.push_str(&position.axes(None, "position (raw, as sent)"));
     line(
         &mut o,
         t.samples
             .iter()
-            .map(|s| (x(s.time), y_pos(s.actual)))
+            .filter_map(|s| {
+                s.target
+                    .map(|v| (position.x(rel(s.time)), position.y(v as f64)))
+            })
             .collect(),
-        "#1f77b4",
+        TARGET,
     );
     line(
         &mut o,
         t.samples
             .iter()
-            .filter_map(|s| s.target.map(|v| (x(s.time), y_pos(v))))
+            .map(|s| (position.x(rel(s.time)), position.y(s.actual as f64)))
             .collect(),
-        "#999999",
+        POSITION,
     );
-    let _ = writeln!(o, "<text x=\"2\" y=\"{:.0}\">speed</text><text x=\"2\" y=\"{:.0}\">{shi:.0}</text><text x=\"2\" y=\"{:.0}\">{slo:.0}</text>", 30.0 + h_pos, 42.0 + h_pos, 20.0 + h_pos + h_speed);
+    let time_title = format!("time since {} ({unit})", format_time(first.time));
+    o.push_str(&speed.axes(Some(&time_title), "speed (rpm)"));
     line(
         &mut o,
         t.samples
             .iter()
-            .map(|s| (x(s.time), y_speed(s.speed)))
+            .map(|s| (speed.x(rel(s.time)), speed.y(s.speed as f64)))
             .collect(),
-        "#2ca02c",
+        SPEED,
     );
-    let top = 40.0 + h_pos + h_speed;
-    for b in 0..16u16 {
-        let y = top + f64::from(b) * row;
-        let name = t
-            .status_names
-            .get(usize::from(b))
-            .map_or("", String::as_str);
-        let short: String = name.chars().take(10).collect();
+    let _ = writeln!(o, "<g class=\"bits\">");
+    for (b, name) in (0..16u16).zip(&names) {
+        let y = bits_top + f64::from(b) * row;
         let _ = writeln!(
             o,
-            "<text x=\"2\" y=\"{:.0}\"><title>{}</title>{b:>2} {}</text>",
-            y + 8.0,
+            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{}</text><line x1=\"{left:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/>",
+            left - 6.0,
+            y + 9.0,
             xml(name),
-            xml(&short)
+            y + row - 1.0,
+            left + width,
+            y + row - 1.0
         );
         let mut start: Option<u64> = None;
         for (i, s) in t.samples.iter().enumerate() {
             let on = s.status & (1 << b) != 0;
-            match (on, start) {
-                (true, None) => start = Some(s.time),
-                (false, Some(st)) => {
-                    let _ = writeln!(o, "<rect x=\"{:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"#ff7f0e\"/>", x(st), (x(s.time) - x(st)).max(0.5), row - 2.0);
-                    start = None;
-                }
-                _ => {}
+            let end = if i + 1 == t.samples.len() && on {
+                Some(s.time)
+            } else if !on {
+                start.map(|_| s.time)
+            } else {
+                None
+            };
+            if on && start.is_none() {
+                start = Some(s.time);
             }
-            if i + 1 == t.samples.len() {
-                if let Some(st) = start {
-                    let _ = writeln!(o, "<rect x=\"{:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"#ff7f0e\"/>", x(st), (x(s.time) - x(st)).max(0.5), row - 2.0);
-                }
+            if let (Some(st), Some(en)) = (start, end) {
+                let (x0, x1) = (position.x(rel(st)), position.x(rel(en)));
+                let _ = writeln!(
+                    o,
+                    "<rect x=\"{x0:.1}\" y=\"{y:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"{BIT}\"><title>{}: {} to {}</title></rect>",
+                    (x1 - x0).max(0.5),
+                    row - 2.0,
+                    xml(name),
+                    xml(&format_time(st)),
+                    xml(&format_time(en))
+                );
+                start = None;
             }
         }
     }
+    o.push_str("</g>\n");
     for m in &t.marks {
-        let mx = x(m.time.max(first.time));
+        let mx = position.x(rel(m.time.max(first.time)));
         let _ = writeln!(
             o,
-            "<line x1=\"{mx:.1}\" y1=\"5\" x2=\"{mx:.1}\" y2=\"{:.0}\" stroke=\"red\" stroke-width=\"1\"><title>{} at {}</title></line>",
-            top + h_bits,
+            "<line class=\"violation\" x1=\"{mx:.1}\" y1=\"{pos_top:.0}\" x2=\"{mx:.1}\" y2=\"{:.0}\" {VIOLATION}><title>{} at {}</title></line>",
+            bits_top + 16.0 * row,
             xml(&m.requirement),
             xml(&format_time(m.time))
         );
     }
-    let _ = writeln!(
-        o,
-        "<text x=\"{left}\" y=\"{:.0}\">{} … {}</text>",
-        height - 5.0,
-        xml(&format_time(first.time)),
-        xml(&format_time(last.time))
-    );
     o.push_str("</svg>\n");
     o
 }
 
+/// Line styles and colours of the timeline.
+const POSITION: &str = "stroke=\"#1f77b4\" stroke-width=\"1.5\"";
+const TARGET: &str = "stroke=\"#999\" stroke-width=\"1\" stroke-dasharray=\"4 2\"";
+const SPEED: &str = "stroke=\"#2ca02c\" stroke-width=\"1.5\"";
+const BIT: &str = "#ff7f0e";
+const VIOLATION: &str = "stroke=\"#d00000\" stroke-width=\"1\"";
+
 /// A self-contained HTML page of `reports`.
 pub fn html(reports: &[Report]) -> String {
-    let mut o = String::from("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>drivespec check</title>\n<style>body{font-family:sans-serif;margin:1em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;text-align:left;vertical-align:top}.fail{color:#b00}.pass{color:#070}code{font-size:90%}</style></head><body>\n<h1>drivespec check</h1>\n");
-    for r in reports {
+    let mut o = String::from("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>drivespec check</title>\n<style>body{font-family:sans-serif;margin:1em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;text-align:left;vertical-align:top}.fail{color:#b00}.pass{color:#070}code{font-size:90%}svg.timeline{display:block;max-width:100%;height:auto}</style></head><body>\n<h1>drivespec check</h1>\n");
+    o.push_str("<table id=\"summary\"><tr><th>recording</th><th>family</th><th>verdict</th><th>must violations</th><th>warnings</th></tr>\n");
+    for (i, r) in reports.iter().enumerate() {
+        let class = if r.passed() { "pass" } else { "fail" };
+        let must = r.must_count();
+        let link = if r.violations.is_empty() {
+            format!("file-{i}")
+        } else {
+            format!("violations-{i}")
+        };
+        let _ = writeln!(
+            o,
+            "<tr><td><a href=\"#{link}\">{}</a></td><td>{}</td><td class=\"{class}\">{}</td><td>{must}</td><td>{}</td></tr>",
+            xml(r.file.as_deref().unwrap_or("stream")),
+            xml(&r.family),
+            xml(r.verdict.as_str()),
+            r.violation_count.saturating_sub(must)
+        );
+    }
+    o.push_str("</table>\n");
+    for (i, r) in reports.iter().enumerate() {
         let class = if r.passed() { "pass" } else { "fail" };
         let _ = writeln!(
             o,
-            "<h2>{} ({}) — <span class=\"{class}\">{}</span></h2><p>{}</p>",
+            "<h2 id=\"file-{i}\">{} ({}) — <span class=\"{class}\">{}</span></h2><p>{}</p>",
             xml(r.file.as_deref().unwrap_or("stream")),
             xml(&r.family),
             xml(r.verdict.as_str()),
@@ -554,26 +624,8 @@ pub fn html(reports: &[Report]) -> String {
             let _ = write!(o, "<li>{}</li>", xml(n));
         }
         o.push_str("</ul>\n");
-        for t in &r.timelines {
-            let _ = writeln!(o, "<h3>{}</h3>", xml(&t.label));
-            o.push_str(&svg(t));
-        }
-        o.push_str("<h3>Requirements</h3><table><tr><th>ID</th><th>level</th><th>violations</th><th>text</th><th>source</th></tr>\n");
-        for (id, t) in &r.requirements {
-            let class = if t.violations > 0 { "fail" } else { "pass" };
-            let _ = writeln!(
-                o,
-                "<tr class=\"{class}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                xml(id),
-                xml(&t.level),
-                t.violations,
-                xml(&t.text),
-                xml(&t.source)
-            );
-        }
-        o.push_str("</table>\n");
         if !r.violations.is_empty() {
-            let _ = writeln!(o, "<h3>Violations ({} listed of {})</h3><table><tr><th>where</th><th>requirement</th><th>subject</th><th>message</th><th>evidence</th></tr>", r.violations.len(), r.violation_count);
+            let _ = writeln!(o, "<h3 id=\"violations-{i}\">Violations ({} listed of {})</h3><table><tr><th>where</th><th>requirement</th><th>subject</th><th>message</th><th>evidence</th></tr>", r.violations.len(), r.violation_count);
             for v in &r.violations {
                 let mut ev = v.evidence.bytes.clone().unwrap_or_default();
                 for (k, val) in &v.evidence.fields {
@@ -596,6 +648,24 @@ pub fn html(reports: &[Report]) -> String {
             }
             o.push_str("</table>\n");
         }
+        for t in &r.timelines {
+            let _ = writeln!(o, "<h3>{}</h3>", xml(&t.label));
+            o.push_str(&svg(t));
+        }
+        o.push_str("<h3>Requirements</h3><table><tr><th>ID</th><th>level</th><th>violations</th><th>text</th><th>source</th></tr>\n");
+        for (id, t) in &r.requirements {
+            let class = if t.violations > 0 { "fail" } else { "pass" };
+            let _ = writeln!(
+                o,
+                "<tr class=\"{class}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                xml(id),
+                xml(&t.level),
+                t.violations,
+                xml(&t.text),
+                xml(&t.source)
+            );
+        }
+        o.push_str("</table>\n");
         if !r.streams.is_empty() {
             o.push_str("<h3>Timing</h3><table><tr><th>stream</th><th>frames</th><th>nominal µs</th><th>interval µs</th><th>jitter max µs</th><th>missing</th></tr>\n");
             for s in r.streams.iter().take(200) {

@@ -525,6 +525,8 @@ struct Run<'r, 's, I, O> {
     cycles: Vec<Cycle<I>>,
     evidence: Vec<Record>,
     failure: Option<Failure>,
+    /// The cycle that shows the failure, when one does (marked on the plot).
+    failed_cycle: Option<usize>,
     reqs: &'r [String],
     /// The cycle counts at which [`Op::Until`] waits ended: both sides had arrived.
     arrivals: Vec<usize>,
@@ -865,6 +867,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 r.note = Some(format!("{LIVE_NOTE}: {allowed}"));
             }
             if run.failure.is_none() {
+                run.failed_cycle = Some(l.cycle);
                 run.failure = Some(Failure {
                     step: Some(l.step),
                     message: format!(
@@ -964,6 +967,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     "the input image differs from the reference (tolerance ±{} cycle(s), position ±{}, speed ±{})",
                     tol.cycles, tol.position, tol.speed
                 );
+                run.failed_cycle = Some(i);
                 run.failure = Some(self.cycle_failure(run.reqs, i, c, &c.reference, what));
             }
         }
@@ -1188,6 +1192,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         .map_or(&c.reference, |r| &r.reference);
                     let mut reqs = f.breaks.clone();
                     reqs.extend(run.reqs.iter().filter(|r| !f.breaks.contains(r)).cloned());
+                    run.failed_cycle = Some(f.cycle);
                     run.failure =
                         Some(self.cycle_failure(&reqs, f.cycle, c, reference, f.what.clone()));
                 }
@@ -1318,6 +1323,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             cycles: Vec::new(),
             evidence: Vec::new(),
             failure: None,
+            failed_cycle: None,
             reqs: &info.requirements,
             arrivals: Vec::new(),
             open: F::open(case),
@@ -1379,7 +1385,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 expected: None,
                 got: None,
                 ok: None,
-                note: Some(plot::encode(&samples)),
+                note: Some(plot::encode(&samples, run.failed_cycle)),
             });
         }
         // An open point is reported with the status bits the device ended with.

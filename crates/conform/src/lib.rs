@@ -16,6 +16,7 @@
 //! Nothing here panics on any input or device behaviour; every wait is bounded by a deadline.
 #![forbid(unsafe_code)]
 
+pub mod bar;
 pub mod case;
 pub mod cyclic;
 pub mod cyclic_session;

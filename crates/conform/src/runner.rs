@@ -8,6 +8,7 @@
 //! device that misbehaves during the run fails cases, with evidence; the run goes on and the
 //! reports are always written.
 
+use crate::bar::Bar;
 use crate::case::{CaseInfo, CaseRun, Outcome};
 use crate::dut::{shell_quote, Dut};
 use crate::report::{
@@ -258,6 +259,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
     let mut interrupted = false;
     let mut heard = false;
     let total = plan.len();
+    let bar = (mode == Progress::Bar).then(|| Bar::count(total as u64, "cases"));
     for (n, (si, ci)) in plan.iter().enumerate() {
         let (Some(suite), Some(session)) = (suites.get(*si), sessions.get_mut(*si)) else {
             continue;
@@ -332,7 +334,7 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
             failed,
             elapsed_s: run_started.elapsed().as_secs_f64(),
         };
-        show(progress, mode, opts.colour, &line);
+        show(progress, mode, bar.as_ref(), opts.colour, &line);
         if mute {
             return Err(ConformError::Mute {
                 cases: n + 1,
@@ -353,8 +355,8 @@ pub fn run(spec: &Spec, opts: &Options, progress: &mut dyn Write) -> Result<Summ
         report.failure = report.failure.take().or(first_failure);
         results.push(report);
     }
-    if mode == Progress::Bar {
-        let _ = writeln!(progress);
+    if let Some(b) = &bar {
+        b.finish();
     }
     let mut report = build_report(
         opts,
@@ -409,9 +411,10 @@ pub fn paint(on: bool, code: &str, text: &str) -> String {
 /// Red, for failures.
 pub const RED: &str = "1;31";
 
-/// One case's progress. A failure shows, in every mode, its headline (the broken requirement,
-/// what the manual allows and what came) and the replay command.
-fn show(out: &mut dyn Write, mode: Progress, colour: bool, l: &Line<'_>) {
+/// One case's progress (on `bar` in [`Progress::Bar`] mode). A failure shows, in every mode,
+/// its headline (the broken requirement, what the manual allows and what came) and the replay
+/// command.
+fn show(out: &mut dyn Write, mode: Progress, bar: Option<&Bar>, colour: bool, l: &Line<'_>) {
     let (n, total) = l.at;
     let fail = l.status == Status::Fail;
     let details = |out: &mut dyn Write| {
@@ -453,16 +456,18 @@ fn show(out: &mut dyn Write, mode: Progress, colour: bool, l: &Line<'_>) {
             }
         }
         Progress::Bar => {
+            let Some(bar) = bar else { return };
             if fail {
-                let _ = write!(out, "\r\x1b[2K");
-                details(out);
+                bar.suspend(|| {
+                    details(out);
+                    let _ = out.flush();
+                });
             }
-            let width = 30;
-            let done = n * width / total.max(1);
-            let bar: String = "#".repeat(done) + &"-".repeat(width - done);
-            let short: String = l.id.chars().take(50).collect();
-            let _ = write!(out, "\r\x1b[2K[{bar}] {n}/{total} {short}");
-            let _ = out.flush();
+            let failed = match l.failed {
+                0 => String::new(),
+                k => format!("{k} failed, "),
+            };
+            bar.set(n as u64, format!("{failed}{}", l.id));
         }
     }
 }
@@ -631,6 +636,7 @@ fn build_report(
         coverage,
         coverage_summary,
         stale_expectations: stale,
+        plot_units: suites.iter().filter_map(|s| s.plot_units()).collect(),
         timing: None,
     }
 }

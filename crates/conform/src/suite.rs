@@ -69,6 +69,12 @@ pub trait Suite {
 
     /// Opens a session on the device under test.
     fn open(&self, dut: &Dut) -> Result<Box<dyn Session + '_>, SetupError>;
+
+    /// The units of the position and speed its motion cases plot; None for a family
+    /// without plots.
+    fn plot_units(&self) -> Option<crate::report::PlotUnits> {
+        None
+    }
 }
 
 /// A connection to one device under test with its reference model.

@@ -37,6 +37,7 @@ pub use replay::{
 };
 pub use stats::{FindingSummary, Stats, STATS_SCHEMA};
 
+use drivespec_conform::bar::Bar;
 use drivespec_conform::case::CaseRun;
 use drivespec_conform::cyclic::{LinkPeer, Peer};
 use drivespec_conform::dut::{shell_quote, Dut};
@@ -364,6 +365,11 @@ fn campaign(
     let mut findings: Vec<Finding> = Vec::new();
     let mut errors: Vec<FuzzError> = Vec::new();
     let every = iterations.map_or(200, |n| (n / 10).max(1));
+    // A count of sequences, or the time spent of the --duration budget.
+    let bar = (mode == Progress::Bar).then(|| match (iterations, opts.duration) {
+        (None, Some(d)) => Bar::time(d),
+        (n, _) => Bar::count(n.unwrap_or(0), "sequences"),
+    });
     let found = {
         let mut on_event = |ev: Event<'_>| match ev {
             Event::Sequence { n, findings: k } => match mode {
@@ -375,17 +381,18 @@ fn campaign(
                     );
                 }
                 Progress::Bar => {
-                    let total = iterations.unwrap_or(0);
-                    let width = 30u64;
-                    let done = n
-                        .saturating_mul(width)
-                        .checked_div(total)
-                        .unwrap_or(0)
-                        .min(width);
-                    let bar: String = "#".repeat(usize::try_from(done).unwrap_or(0))
-                        + &"-".repeat(usize::try_from(width - done).unwrap_or(0));
-                    let _ = write!(progress, "\r\x1b[2K[{bar}] {n} sequences, {k} finding(s)");
-                    let _ = progress.flush();
+                    if let Some(b) = &bar {
+                        if iterations.is_some() {
+                            b.set(n, format!("{k} finding(s)"));
+                        } else {
+                            let spent = clock.elapsed();
+                            let rate = n as f64 / spent.as_secs_f64().max(1e-3);
+                            b.set(
+                                u64::try_from(spent.as_millis()).unwrap_or(u64::MAX),
+                                format!("{n} sequences, {rate:.0}/s, {k} finding(s)"),
+                            );
+                        }
+                    }
                 }
                 _ => {}
             },
@@ -402,10 +409,7 @@ fn campaign(
                         Err(e) => errors.push(e.into()),
                     }
                 }
-                if mode != Progress::Quiet {
-                    if mode == Progress::Bar {
-                        let _ = write!(progress, "\r\x1b[2K");
-                    }
+                let say = |progress: &mut dyn Write| {
                     let _ = writeln!(
                         progress,
                         "{id}: {} in {} step(s) (from {}){}",
@@ -421,6 +425,12 @@ fn campaign(
                     if let Some(file) = &finding.file {
                         let _ = writeln!(progress, "  replay: {}", replay_line(opts, file));
                     }
+                    let _ = progress.flush();
+                };
+                match (&bar, mode) {
+                    (_, Progress::Quiet) => {}
+                    (Some(b), _) => b.suspend(|| say(&mut *progress)),
+                    (None, _) => say(&mut *progress),
                 }
                 findings.push(finding);
             }
@@ -449,8 +459,12 @@ fn campaign(
         };
         engine::campaign(target, settings.seed, limits, &mut stats, &mut on_event)
     };
-    if mode == Progress::Bar {
-        let _ = writeln!(progress);
+    if let Some(b) = &bar {
+        // A time bar ends at the time spent: full when the budget ran out.
+        if iterations.is_none() {
+            b.reach(u64::try_from(clock.elapsed().as_millis()).unwrap_or(u64::MAX));
+        }
+        b.finish();
     }
     if let Some(e) = errors.into_iter().next() {
         return Err(e);

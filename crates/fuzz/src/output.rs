@@ -227,6 +227,7 @@ pub(crate) fn build(
         coverage,
         coverage_summary,
         stale_expectations: Vec::new(),
+        plot_units: Vec::new(),
         timing: None,
     }
 }

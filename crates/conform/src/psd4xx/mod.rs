@@ -149,4 +149,24 @@ impl Suite for Psd4xxSuite<'_> {
         s.hello().map_err(SetupError::Usage)?;
         Ok(Box::new(s))
     }
+
+    /// The units of the input image's `actual` and `speed` fields' parameters.
+    fn plot_units(&self) -> Option<crate::report::PlotUnits> {
+        let drivespec_spec::Protocol::Psd4xx(proto) = &self.family.protocol else {
+            return None;
+        };
+        let fields = &proto.process_data.input.fields;
+        let param = |name: &str| {
+            fields
+                .iter()
+                .find(|f| f.name == name)
+                .and_then(|f| f.param.as_deref())
+        };
+        Some(crate::report::PlotUnits::of(
+            FamilyId::Psd4xx,
+            self.family,
+            param("actual"),
+            param("speed"),
+        ))
+    }
 }

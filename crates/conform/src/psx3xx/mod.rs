@@ -141,4 +141,23 @@ impl Suite for Psx3xxSuite<'_> {
         s.hello().map_err(SetupError::Usage)?;
         Ok(Box::new(s))
     }
+
+    /// The units of the input image's `actual` and `rpm` fields' parameters.
+    fn plot_units(&self) -> Option<crate::report::PlotUnits> {
+        use drivespec_psx3xx::rules::names;
+        let fields = &self.reference().rules().protocol().process_input.fields;
+        let param = |name: &str| {
+            fields
+                .iter()
+                .find(|f| f.name == name)
+                .and_then(|f| f.params.first())
+                .map(String::as_str)
+        };
+        Some(crate::report::PlotUnits::of(
+            FamilyId::Psx3xx,
+            self.family,
+            param(names::ACTUAL),
+            param(names::RPM),
+        ))
+    }
 }

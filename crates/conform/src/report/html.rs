@@ -1,11 +1,13 @@
-//! A self-contained HTML report (no scripts, no external resources): the summary, the
-//! requirement coverage matrix (requirement → cases → verdict) and every case with its
-//! evidence; failing cases are listed first and open.
+//! A self-contained HTML report (no scripts, no external resources): the summary with a link
+//! to every failure, then per family every case with its evidence (failures first and open,
+//! then known failures, flaky and acceptable cases, passes, cases not run), then the
+//! requirement coverage matrix (requirement → cases → verdict).
 
-use super::{CaseReport, Coverage, Report, Status};
+use super::{CaseReport, Coverage, PlotUnits, Report, Status};
 use drivespec_report::escape;
 use drivespec_report::html::anchor;
 use drivespec_report::plot;
+use drivespec_spec::FamilyId;
 use std::fmt::Write as _;
 
 const STYLE: &str = "body{font:14px/1.4 system-ui,sans-serif;margin:2em;color:#222}\
@@ -14,7 +16,7 @@ table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding
 .pass{color:#176f2c}.acceptable{color:#2d6a8f}.fail{color:#b00020;font-weight:bold}.expected-failure{color:#a15c00}.fixed{color:#0057b3}\
 .skipped,.not-run,.untested{color:#777}code,pre{font:12px ui-monospace,monospace}pre{white-space:pre-wrap;margin:0}\
 details{margin:.3em 0;border-left:3px solid #ddd;padding-left:.6em}summary{cursor:pointer}\
-.bad{background:#fde8ea}.muted{color:#777}";
+.bad{background:#fde8ea}.muted{color:#777}svg.plot{display:block;max-width:100%;height:auto}";
 
 /// The report as one HTML page.
 pub fn html(r: &Report) -> String {
@@ -27,7 +29,7 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}: {}</title><style>{STYLE}</style></head><body>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}: {}</title><style>{STYLE}</style></head><body>\n<section id=\"summary\">\n",
         escape(tool),
         escape(&r.run.dut)
     );
@@ -83,6 +85,28 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
         );
     }
     h.push_str(extra);
+    failure_list(&mut h, r);
+    h.push_str("</section>\n");
+    let mut families: Vec<FamilyId> = Vec::new();
+    for c in &r.cases {
+        if !families.contains(&c.family) {
+            families.push(c.family);
+        }
+    }
+    for family in families {
+        let units = r.plot_units.iter().find(|u| u.family == family);
+        let _ = writeln!(
+            h,
+            "<h2 id=\"cases-{}\">Cases: {}</h2>",
+            anchor(&family.to_string()),
+            escape(&family.to_string())
+        );
+        let mut cases: Vec<&CaseReport> = r.cases.iter().filter(|c| c.family == family).collect();
+        cases.sort_by_key(|c| rank(c.status));
+        for c in cases {
+            case(&mut h, c, units);
+        }
+    }
     h.push_str("<h2>Requirement coverage</h2>\n<table><tr><th>requirement</th><th>level</th><th>verdict</th><th>cases</th><th>text</th></tr>\n");
     for row in &r.coverage {
         let v = match row.verdict {
@@ -126,23 +150,62 @@ pub fn html_with(r: &Report, tool: &str, extra: &str) -> String {
             escape(&row.text)
         );
     }
-    h.push_str("</table>\n<h2>Cases</h2>\n");
-    let order = |c: &&CaseReport| match c.status {
-        Status::Fail => 0,
-        Status::ExpectedFailure => 1,
-        Status::Fixed => 2,
-        _ => 3,
-    };
-    let mut cases: Vec<&CaseReport> = r.cases.iter().collect();
-    cases.sort_by_key(order);
-    for c in cases {
-        case(&mut h, c);
-    }
+    h.push_str("</table>\n");
     h.push_str("</body></html>\n");
     h
 }
 
-fn case(h: &mut String, c: &CaseReport) {
+/// Where a case stands in its family's list: failures first, passes late, cases not run last.
+fn rank(s: Status) -> u8 {
+    match s {
+        Status::Fail => 0,
+        Status::ExpectedFailure => 1,
+        Status::Fixed => 2,
+        Status::Flaky => 3,
+        Status::Acceptable => 4,
+        Status::Pass => 5,
+        Status::Skipped => 6,
+        Status::NotRun => 7,
+    }
+}
+
+/// The failures of the run (then the known failures and the fixed cases), each a link to
+/// its case with the reason in one line.
+fn failure_list(h: &mut String, r: &Report) {
+    for (status, title) in [
+        (Status::Fail, "Failures"),
+        (Status::ExpectedFailure, "Known failures"),
+        (
+            Status::Fixed,
+            "Fixed (listed as known failures, now passing)",
+        ),
+    ] {
+        let cases: Vec<&CaseReport> = r.cases.iter().filter(|c| c.status == status).collect();
+        if cases.is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            h,
+            "<h2>{title} ({})</h2>\n<ol class=\"{}-list\">",
+            cases.len(),
+            status.as_str()
+        );
+        for c in cases {
+            let why = c.failure.as_ref().map_or("", |f| f.message.as_str());
+            let _ = writeln!(
+                h,
+                "<li><a href=\"#{}\" class=\"{}\">{}</a> {}</li>",
+                anchor(&c.id),
+                status.as_str(),
+                escape(&c.id),
+                escape(why)
+            );
+        }
+        h.push_str("</ol>\n");
+    }
+}
+
+fn case(h: &mut String, c: &CaseReport, units: Option<&PlotUnits>) {
     let open = if c.status == Status::Fail {
         " open"
     } else {
@@ -212,8 +275,12 @@ fn case(h: &mut String, c: &CaseReport) {
     );
     // Positioning cases: position/speed/status over time, reference vs device (inline SVG).
     for e in c.evidence.iter().filter(|e| e.action == plot::ACTION) {
-        if let Some(svg) = e.note.as_deref().and_then(plot::svg) {
-            let _ = writeln!(h, "<p>{svg}</p>");
+        let units = plot::Units {
+            position: units.map_or("raw", |u| u.position.as_str()),
+            speed: units.map_or("raw", |u| u.speed.as_str()),
+        };
+        if let Some(svg) = e.note.as_deref().and_then(|n| plot::svg(n, units)) {
+            let _ = writeln!(h, "<figure>{svg}</figure>");
         }
     }
     if !c.evidence.is_empty() && c.status != Status::Pass {

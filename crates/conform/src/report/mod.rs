@@ -9,7 +9,7 @@ pub use html::{html, html_with};
 pub use junit::{junit, junit_with};
 
 use crate::case::{Failure, Finding, Record};
-use drivespec_spec::{FamilyId, Level};
+use drivespec_spec::{Family, FamilyId, Level};
 use serde::Serialize;
 
 /// Name and version of the JSON schema (`crates/conform/README.md`, "JSON report").
@@ -73,10 +73,43 @@ pub struct Report {
     pub coverage_summary: Vec<FamilyCoverage>,
     /// Expectations entries that matched no selected case.
     pub stale_expectations: Vec<crate::select::KnownFailure>,
+    /// The units of each plotting family's position and speed (HTML plots); not in the JSON.
+    #[serde(skip)]
+    pub plot_units: Vec<PlotUnits>,
     /// When the run started and how long it took (JUnit); not in the JSON, which stays the
     /// same for the same run.
     #[serde(skip)]
     pub timing: Option<Timing>,
+}
+
+/// The units a family's plots give the position and speed in: the spec `unit` of the
+/// parameters the input image carries them as.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PlotUnits {
+    /// The family.
+    pub family: FamilyId,
+    /// Unit of the position (`increments`).
+    pub position: String,
+    /// Unit of the speed (`rpm`).
+    pub speed: String,
+}
+
+impl PlotUnits {
+    /// The units of `family`'s parameters `position` and `speed` (IDs); `raw` for one the
+    /// spec gives no unit.
+    pub fn of(id: FamilyId, family: &Family, position: Option<&str>, speed: Option<&str>) -> Self {
+        let unit = |param: Option<&str>| {
+            param
+                .and_then(|p| family.parameters.iter().find(|x| x.id == p))
+                .and_then(|p| p.unit.clone())
+                .unwrap_or_else(|| "raw".to_owned())
+        };
+        PlotUnits {
+            family: id,
+            position: unit(position),
+            speed: unit(speed),
+        }
+    }
 }
 
 /// When a run started and how long it took.
