@@ -66,7 +66,10 @@ impl PnioNames {
     pub fn shared() -> Result<&'static PnioNames, NamesError> {
         static NAMES: std::sync::OnceLock<Result<PnioNames, NamesError>> =
             std::sync::OnceLock::new();
-        NAMES.get_or_init(PnioNames::load).as_ref().map_err(Clone::clone)
+        NAMES
+            .get_or_init(PnioNames::load)
+            .as_ref()
+            .map_err(Clone::clone)
     }
 
     /// Reads the names file.

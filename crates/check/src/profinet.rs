@@ -1576,6 +1576,22 @@ fn output_good(b: &Binding, data: &[u8]) -> bool {
         .is_none_or(|iops| iops & 0x80 != 0)
 }
 
+/// Adds a violation of `id` to `found`, with its message and evidence made only when the
+/// recorder will list it (a fuzzed or broken stream violates on every frame).
+fn found_push(
+    found: &mut Vec<(&'static str, String, Evidence)>,
+    rec: &Recorder,
+    id: &'static str,
+    detail: impl FnOnce() -> (String, Evidence),
+) {
+    let (message, evidence) = if rec.lists(id) {
+        detail()
+    } else {
+        (String::new(), Evidence::none())
+    };
+    found.push((id, message, evidence));
+}
+
 /// The generic checks of one cyclic frame of stream `s`.
 fn stream_frame(
     s: &mut Stream,
@@ -1607,24 +1623,26 @@ fn stream_frame(
         }
         if !restart {
             if delta == 0 || delta > 0x8000 {
-                found.push((
-                    "PN-RT-CC-002",
-                    format!(
-                        "cycle counter {counter} after {last} ({})",
-                        if delta == 0 { "repeated" } else { "backwards" }
-                    ),
-                    ev().with("previous", last)
-                        .with("previous_frame", last_at.frame),
-                ));
+                found_push(found, rec, "PN-RT-CC-002", || {
+                    (
+                        format!(
+                            "cycle counter {counter} after {last} ({})",
+                            if delta == 0 { "repeated" } else { "backwards" }
+                        ),
+                        ev().with("previous", last)
+                            .with("previous_frame", last_at.frame),
+                    )
+                });
             } else if let Some(inc) = s.increment {
                 if delta % inc != 0 {
-                    found.push((
-                        "PN-RT-CC-001",
-                        format!(
+                    found_push(found, rec, "PN-RT-CC-001", || {
+                        (
+                            format!(
                             "cycle counter advanced by {delta}, not a multiple of the send interval {inc}"
                         ),
-                        ev().with("previous", last).with("increment", inc),
-                    ));
+                            ev().with("previous", last).with("increment", inc),
+                        )
+                    });
                 } else {
                     let steps = u64::from(delta / inc);
                     // Frames missing: the cycles the counter skipped, unless the capture
@@ -1640,21 +1658,23 @@ fn stream_frame(
                         s.jitter.add((d as f64 - (steps * nominal) as f64).abs());
                         let expected = u64::from(delta) * COUNT_NS / 1000;
                         if d > expected * 2 + 4000 || d + 4000 < expected / 2 {
-                            found.push((
-                                "PN-RT-CC-003",
-                                format!(
+                            found_push(found, rec, "PN-RT-CC-003", || {
+                                (
+                                    format!(
                                     "{d} µs between frames whose cycle counters are {expected} µs apart"
                                 ),
-                                ev().with("interval_us", d).with("counter_us", expected),
-                            ));
+                                    ev().with("interval_us", d).with("counter_us", expected),
+                                )
+                            });
                         }
                         if let Some(w) = s.info.as_ref().and_then(|i| i.watchdog_us) {
                             if d > w {
-                                found.push((
-                                    "PN-RT-WD-001",
-                                    format!("{d} µs without a frame, more than the watchdog time {w} µs"),
-                                    ev().with("gap_us", d),
-                                ));
+                                found_push(found, rec, "PN-RT-WD-001", || {
+                                    (
+                                        format!("{d} µs without a frame, more than the watchdog time {w} µs"),
+                                        ev().with("gap_us", d),
+                                    )
+                                });
                             }
                         }
                     }
@@ -1779,11 +1799,12 @@ fn stream_frame(
                 );
                 s.iox_allowed.push((offset, listed));
             } else {
-                found.push((
-                    id,
-                    format!("{label} = {b:#04x} (bad)"),
-                    ev().with("offset", offset).with("iox", format!("{b:#04x}")),
-                ));
+                found_push(found, rec, id, || {
+                    (
+                        format!("{label} = {b:#04x} (bad)"),
+                        ev().with("offset", offset).with("iox", format!("{b:#04x}")),
+                    )
+                });
             }
         }
         if good && was.is_some_and(|g| !g) {

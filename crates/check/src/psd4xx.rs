@@ -350,18 +350,19 @@ impl<'s> PsdDrive<'s> {
         self.timeline
     }
 
+    /// Records a violation of `id`; the message and evidence are made only when the recorder
+    /// lists it (a broken stream violates on every image).
     fn violation(
         &mut self,
         rec: &mut Recorder,
         id: &str,
         at: Where,
-        message: impl Into<String>,
-        ev: Evidence,
+        detail: impl FnOnce() -> (String, Evidence),
     ) {
         if let Some(t) = at.time {
             self.timeline.mark(t, id);
         }
-        rec.violation(id, &self.label, at, message, ev);
+        rec.violation_with(id, &self.label, at, detail);
     }
 
     /// The oracle's time for a capture time: µs since the drive's first event (the model
@@ -427,13 +428,12 @@ impl<'s> PsdDrive<'s> {
                 _ => "PSD-CTL-ZERO-001",
             };
             rec.checks(&[id]);
-            self.violation(
-                rec,
-                id,
-                at,
-                format!("control word {control:#06x} sets reserved bit {b}"),
-                Evidence::bytes(bytes).with("control", format!("{control:#06x}")),
-            );
+            self.violation(rec, id, at, || {
+                (
+                    format!("control word {control:#06x} sets reserved bit {b}"),
+                    Evidence::bytes(bytes).with("control", format!("{control:#06x}")),
+                )
+            });
         }
         // Release withdrawn during a positioning run (not a manual run): bit 5 must follow.
         let p = prev.unwrap_or(0);
@@ -460,10 +460,7 @@ impl<'s> PsdDrive<'s> {
                 let ev = Evidence::bytes(bytes)
                     .with("command", self.pkw().describe_request(&c.req))
                     .with("new_command", self.pkw().describe_request(&req));
-                self.violation(
-                    rec,
-                    "PSD-PKW-002",
-                    at,
+                let detail: (String, Evidence) = (
                     format!(
                         "the controller replaced `{}` (sent at {}) before the drive answered it",
                         self.pkw().describe_request(&c.req),
@@ -471,6 +468,7 @@ impl<'s> PsdDrive<'s> {
                     ),
                     ev,
                 );
+                self.violation(rec, "PSD-PKW-002", at, || detail);
             }
         }
         self.command = Some(Command {
@@ -512,13 +510,12 @@ impl<'s> PsdDrive<'s> {
         // PSD-STS-0-PRIO: bit 0 wins over bit 10, never both.
         let both = inp.status & bit::TARGET_REACHED != 0 && inp.status & bit::OVERLOAD != 0;
         if both && !self.prio_state {
-            self.violation(
-                rec,
-                "PSD-STS-0-PRIO",
-                at,
-                "status bits 0 (target reached) and 10 (overload) are set together",
-                ev(),
-            );
+            self.violation(rec, "PSD-STS-0-PRIO", at, || {
+                (
+                    "status bits 0 (target reached) and 10 (overload) are set together".into(),
+                    ev(),
+                )
+            });
         }
         self.prio_state = both;
         // PSD-CTL-13-001: control bit 13 comes back in status bit 2.
@@ -526,17 +523,11 @@ impl<'s> PsdDrive<'s> {
             let want = out.control & bit::TOGGLE != 0;
             let have = inp.status & bit::TOGGLE_ECHO != 0;
             if let Some(w) = self.toggle.update(want != have, n, at, bytes, lag) {
-                self.violation(
-                    rec,
-                    "PSD-CTL-13-001",
-                    w.at,
-                    format!(
+                self.violation(rec, "PSD-CTL-13-001", w.at, || (format!(
                         "status bit 2 = {} does not echo control bit 13 = {} from here to {at} ({lag} input images)",
                         u8::from(have),
                         u8::from(want)
-                    ),
-                    held(&w, at).with("control", format!("{:#06x}", out.control)),
-                );
+                    ), held(&w, at).with("control", format!("{:#06x}", out.control))));
             }
         }
         // PSD-STS-6-SET-1 / PSD-STS-6-RESET-1: the running bit follows the speed.
@@ -545,16 +536,10 @@ impl<'s> PsdDrive<'s> {
             self.speed_without_run
                 .update(!running && inp.speed != 0, n, at, bytes, lag)
         {
-            self.violation(
-                rec,
-                "PSD-STS-6-SET-1",
-                w.at,
-                format!(
+            self.violation(rec, "PSD-STS-6-SET-1", w.at, || (format!(
                     "speed {} rpm with status bit 6 (running) clear from here to {at} ({lag} input images)",
                     inp.speed
-                ),
-                held(&w, at).with("speed", inp.speed),
-            );
+                ), held(&w, at).with("speed", inp.speed)));
         }
         if let Some(w) = self.run_without_speed.update(
             running && inp.speed == 0,
@@ -563,16 +548,15 @@ impl<'s> PsdDrive<'s> {
             bytes,
             lag.saturating_mul(5),
         ) {
-            self.violation(
-                rec,
-                "PSD-STS-6-RESET-1",
-                w.at,
-                format!(
-                    "status bit 6 (running) set at speed 0 from here to {at} ({} input images)",
-                    lag.saturating_mul(5)
-                ),
-                held(&w, at),
-            );
+            self.violation(rec, "PSD-STS-6-RESET-1", w.at, || {
+                (
+                    format!(
+                        "status bit 6 (running) set at speed 0 from here to {at} ({} input images)",
+                        lag.saturating_mul(5)
+                    ),
+                    held(&w, at),
+                )
+            });
         }
         // PSD-STS-5-SET-1: a positioning run aborted by withdrawing the release sets bit 5.
         if let Some((since, w)) = self.abort_pending.take() {
@@ -580,13 +564,7 @@ impl<'s> PsdDrive<'s> {
             let shown = inp.status & (bit::ABORTED | bit::TARGET_REACHED) != 0;
             let stopped = n.saturating_sub(since) >= lag && !running;
             if !shown && stopped {
-                self.violation(
-                    rec,
-                    "PSD-STS-5-SET-1",
-                    w.at,
-                    format!("the release is withdrawn here during a run; the drive stopped at {at} without status bit 5"),
-                    held(&w, at).with("status", format!("{:#06x}", inp.status)),
-                );
+                self.violation(rec, "PSD-STS-5-SET-1", w.at, || (format!("the release is withdrawn here during a run; the drive stopped at {at} without status bit 5"), held(&w, at).with("status", format!("{:#06x}", inp.status))));
             } else if !shown {
                 self.abort_pending = Some((since, w));
             }
@@ -678,19 +656,13 @@ impl<'s> PsdDrive<'s> {
             } else {
                 ""
             };
-            self.violation(
-                rec,
-                "PSD-PAR-44-001",
-                at,
-                format!(
+            self.violation(rec, "PSD-PAR-44-001", at, || (format!(
                     "target reached (status bit 0){running} at {} while the target is {target}: {off} apart, window {window} ({basis})",
                     inp.actual
-                ),
-                Evidence::bytes(bytes)
+                ), Evidence::bytes(bytes)
                     .with("actual", inp.actual)
                     .with("target", target)
-                    .with("window", window),
-            );
+                    .with("window", window)));
         }
         self.window_state = bad;
     }
@@ -742,18 +714,12 @@ impl<'s> PsdDrive<'s> {
             } else {
                 ""
             };
-            self.violation(
-                rec,
-                "PSD-STS-12-SET-1",
-                w.at,
-                format!(
+            self.violation(rec, "PSD-STS-12-SET-1", w.at, || (format!(
                     "target {target} transferred here lies beyond the limit {limit}; status bit 12 (incorrect target value) is not set at {at}{running}"
-                ),
-                held(&w, at)
+                ), held(&w, at)
                     .with("target", target)
                     .with("limit", limit)
-                    .with("status", format!("{:#06x}", inp.status)),
-            );
+                    .with("status", format!("{:#06x}", inp.status))));
         }
     }
 
@@ -768,25 +734,13 @@ impl<'s> PsdDrive<'s> {
         if let Some(upper) = self.known.get(&par::UPPER_LIMIT).map(|k| k.value) {
             let bad = standstill && inp.status & bit::UPPER_LIMIT != 0 && actual < upper - window;
             if let Some(w) = self.upper.update(bad, n, at, bytes, lag) {
-                self.violation(
-                    rec,
-                    "PSD-STS-14-RESET-1",
-                    w.at,
-                    format!("status bit 14 (upper limit) set at {actual}, inside the limit {upper}, from here to {at}"),
-                    held(&w, at).with("actual", actual).with("upper_limit", upper),
-                );
+                self.violation(rec, "PSD-STS-14-RESET-1", w.at, || (format!("status bit 14 (upper limit) set at {actual}, inside the limit {upper}, from here to {at}"), held(&w, at).with("actual", actual).with("upper_limit", upper)));
             }
         }
         if let Some(lower) = self.known.get(&par::LOWER_LIMIT).map(|k| k.value) {
             let bad = standstill && inp.status & bit::LOWER_LIMIT != 0 && actual > lower + window;
             if let Some(w) = self.lower.update(bad, n, at, bytes, lag) {
-                self.violation(
-                    rec,
-                    "PSD-STS-15-RESET-1",
-                    w.at,
-                    format!("status bit 15 (lower limit) set at {actual}, inside the limit {lower}, from here to {at}"),
-                    held(&w, at).with("actual", actual).with("lower_limit", lower),
-                );
+                self.violation(rec, "PSD-STS-15-RESET-1", w.at, || (format!("status bit 15 (lower limit) set at {actual}, inside the limit {lower}, from here to {at}"), held(&w, at).with("actual", actual).with("lower_limit", lower)));
             }
         }
     }
@@ -886,7 +840,7 @@ impl<'s> PsdDrive<'s> {
         let id = if manual { "PSD-VEL-001" } else { "PSD-VEL-002" };
         let bad = finding.is_some();
         if let (Some((message, ev)), false) = (finding, self.too_fast) {
-            self.violation(rec, id, at, message, ev);
+            self.violation(rec, id, at, || (message, ev));
         }
         self.too_fast = bad;
     }
@@ -895,13 +849,12 @@ impl<'s> PsdDrive<'s> {
 
     fn pkw_answer(&mut self, rec: &mut Recorder, at: Where, bytes: &[u8], resp: PkwResponse) {
         if resp.spm != self.spm_state && resp.spm {
-            self.violation(
-                rec,
-                "PSD-PKW-010",
-                at,
-                "the drive sets SPM (spontaneous messages are not implemented)",
-                Evidence::bytes(bytes.get(..8).unwrap_or(bytes)),
-            );
+            self.violation(rec, "PSD-PKW-010", at, || {
+                (
+                    "the drive sets SPM (spontaneous messages are not implemented)".into(),
+                    Evidence::bytes(bytes.get(..8).unwrap_or(bytes)),
+                )
+            });
         }
         self.spm_state = resp.spm;
         let Some(mut c) = self.command else {
@@ -915,10 +868,7 @@ impl<'s> PsdDrive<'s> {
             let late = self.inputs.saturating_sub(c.since) > self.options.lag_cycles;
             if resp.ak != no_response && late && !c.reported {
                 c.reported = true;
-                self.violation(
-                    rec,
-                    "PSD-PKW-006",
-                    at,
+                let detail: (String, Evidence) = (
                     format!(
                         "response `{}` to command 0 (no command, sent at {})",
                         self.pkw().describe_response(&resp),
@@ -926,6 +876,7 @@ impl<'s> PsdDrive<'s> {
                     ),
                     pkw_ev(),
                 );
+                self.violation(rec, "PSD-PKW-006", at, || detail);
             }
             self.command = Some(c);
             return;
@@ -935,10 +886,7 @@ impl<'s> PsdDrive<'s> {
                 // PSD-PKW-003: the response is held until the controller sends a new command.
                 if resp != answer && !c.reported {
                     c.reported = true;
-                    self.violation(
-                        rec,
-                        "PSD-PKW-003",
-                        at,
+                    let detail: (String, Evidence) = (
                         format!(
                             "the response changed from `{}` to `{}` while the command `{}` stayed",
                             self.pkw().describe_response(&answer),
@@ -947,6 +895,7 @@ impl<'s> PsdDrive<'s> {
                         ),
                         pkw_ev(),
                     );
+                    self.violation(rec, "PSD-PKW-003", at, || detail);
                 }
             }
             None if self.pkw().answers(&c.req, &resp) => {
@@ -958,10 +907,7 @@ impl<'s> PsdDrive<'s> {
             None => {
                 if self.inputs.saturating_sub(c.since) > self.options.pkw_cycles && !c.reported {
                     c.reported = true;
-                    self.violation(
-                        rec,
-                        "PSD-PKW-002",
-                        c.at,
+                    let detail: (String, Evidence) = (
                         format!(
                             "no response to `{}`, sent here, within {} input images (until {at})",
                             self.pkw().describe_request(&c.req),
@@ -971,6 +917,7 @@ impl<'s> PsdDrive<'s> {
                             .with("command", self.pkw().describe_request(&c.req))
                             .with("still_at", at.to_string()),
                     );
+                    self.violation(rec, "PSD-PKW-002", c.at, || detail);
                 }
             }
         }
@@ -997,31 +944,29 @@ impl<'s> PsdDrive<'s> {
         match verdict {
             Verdict::UnknownCommand => {
                 if resp.ak != cannot {
-                    self.violation(
-                        rec,
-                        "PSD-PKW-019",
-                        at,
-                        format!(
-                            "unknown command {} answered with response {}",
-                            u8::from(req.ak),
-                            u8::from(resp.ak)
-                        ),
-                        ev,
-                    );
+                    self.violation(rec, "PSD-PKW-019", at, || {
+                        (
+                            format!(
+                                "unknown command {} answered with response {}",
+                                u8::from(req.ak),
+                                u8::from(resp.ak)
+                            ),
+                            ev,
+                        )
+                    });
                 }
                 return;
             }
             Verdict::NotAllowed => {
-                self.violation(
-                    rec,
-                    id,
-                    at,
-                    format!(
-                        "response {} is not an answer the command allows",
-                        u8::from(resp.ak)
-                    ),
-                    ev,
-                );
+                self.violation(rec, id, at, || {
+                    (
+                        format!(
+                            "response {} is not an answer the command allows",
+                            u8::from(resp.ak)
+                        ),
+                        ev,
+                    )
+                });
                 return;
             }
             Verdict::Negative => {
@@ -1036,42 +981,40 @@ impl<'s> PsdDrive<'s> {
         let param = rules.parameter(u32::from(req.pnu));
         // A positive answer for a parameter the drive does not have (error 0 is due).
         if param.is_none() {
-            self.violation(
-                rec,
-                "PSD-PKW-023",
-                at,
-                format!(
-                    "positive answer for parameter {}, which the drive does not have",
-                    req.pnu
-                ),
-                ev,
-            );
+            self.violation(rec, "PSD-PKW-023", at, || {
+                (
+                    format!(
+                        "positive answer for parameter {}, which the drive does not have",
+                        req.pnu
+                    ),
+                    ev,
+                )
+            });
             return;
         }
         if let Some(code) = pkw.expected_response(&req) {
             if code != resp.ak {
-                self.violation(
-                    rec,
-                    id,
-                    at,
-                    format!(
-                        "response {} where the parameter's width calls for {}",
-                        u8::from(resp.ak),
-                        u8::from(code)
-                    ),
-                    ev,
-                );
+                self.violation(rec, id, at, || {
+                    (
+                        format!(
+                            "response {} where the parameter's width calls for {}",
+                            u8::from(resp.ak),
+                            u8::from(code)
+                        ),
+                        ev,
+                    )
+                });
                 return;
             }
         }
         if let Some(false) = pkw.echo_holds(&req, &resp) {
-            self.violation(
-                rec,
-                "PSD-PKW-034",
-                at,
-                "the answer to the write does not repeat PNU, IND and PWE of the command",
-                ev.clone(),
-            );
+            self.violation(rec, "PSD-PKW-034", at, || {
+                (
+                    "the answer to the write does not repeat PNU, IND and PWE of the command"
+                        .into(),
+                    ev.clone(),
+                )
+            });
         }
         let string = pkw.string_access(req.pnu).is_some();
         let width = if info.array {
@@ -1084,16 +1027,15 @@ impl<'s> PsdDrive<'s> {
                 && pkw.pwe_of(pkw.raw_of(resp.pwe, Width::Word), Width::Word, false) != resp.pwe
                 && pkw.pwe_of(pkw.raw_of(resp.pwe, Width::Word), Width::Word, true) != resp.pwe
             {
-                self.violation(
-                    rec,
-                    "PSD-PKW-038",
-                    at,
-                    format!(
-                        "16-bit value with PWE {:#010x}: the unused word is not 0",
-                        resp.pwe
-                    ),
-                    ev.clone(),
-                );
+                self.violation(rec, "PSD-PKW-038", at, || {
+                    (
+                        format!(
+                            "16-bit value with PWE {:#010x}: the unused word is not 0",
+                            resp.pwe
+                        ),
+                        ev.clone(),
+                    )
+                });
             }
         }
         if string || info.array || info.op == PkwOp::Count {
@@ -1122,32 +1064,30 @@ impl<'s> PsdDrive<'s> {
         if p.range_note.is_none() && (!p.range_model || self.model.is_some()) {
             if let Some(r) = self.family.resolve(p, self.model).range {
                 if !r.contains(value) {
-                    self.violation(
-                        rec,
-                        "PSD-PAR-RANGE-001",
-                        at,
-                        format!(
-                            "par {pnu} ({}) reads {value}, outside its range {r}",
-                            p.name
-                        ),
-                        ev.clone().with("value", value),
-                    );
+                    self.violation(rec, "PSD-PAR-RANGE-001", at, || {
+                        (
+                            format!(
+                                "par {pnu} ({}) reads {value}, outside its range {r}",
+                                p.name
+                            ),
+                            ev.clone().with("value", value),
+                        )
+                    });
                 }
             }
         }
         if !p.live {
             if let Some(k) = self.known.get(&pnu).copied() {
                 if k.value != value {
-                    self.violation(
-                        rec,
-                        "PSD-PKW-021",
-                        at,
-                        format!(
+                    self.violation(rec, "PSD-PKW-021", at, || {
+                        (
+                            format!(
                             "par {pnu} ({}) reads {value}, but the capture established {} at {}",
                             p.name, k.value, k.at
                         ),
-                        ev.with("value", value).with("expected", k.value),
-                    );
+                            ev.with("value", value).with("expected", k.value),
+                        )
+                    });
                 }
             }
             let seedable = p.access.writable() && pnu != par::COMMAND && p.conditions.is_empty();
@@ -1196,16 +1136,10 @@ impl<'s> PsdDrive<'s> {
             };
             if let Some(id) = id {
                 let name = self.pkw().errors().name(e).unwrap_or("?").to_owned();
-                self.violation(
-                    rec,
-                    id,
-                    at,
-                    format!(
+                self.violation(rec, id, at, || (format!(
                         "the drive accepted par {pnu} = {value}; the reference model refuses it with error {} ({name})",
                         u32::from(e)
-                    ),
-                    ev.with("value", value),
-                );
+                    ), ev.with("value", value)));
                 return;
             }
         }
@@ -1286,13 +1220,12 @@ impl<'s> PsdDrive<'s> {
             return;
         };
         if !pkw.errors().contains(e) {
-            self.violation(
-                rec,
-                "PSD-PKW-022",
-                at,
-                format!("error code {} is not in the error table", resp.pwe),
-                ev,
-            );
+            self.violation(rec, "PSD-PKW-022", at, || {
+                (
+                    format!("error code {} is not in the error table", resp.pwe),
+                    ev,
+                )
+            });
             return;
         }
         let p = rules.parameter(u32::from(req.pnu));
@@ -1348,17 +1281,16 @@ impl<'s> PsdDrive<'s> {
         };
         if !plausible {
             let name = pkw.errors().name(e).unwrap_or("?").to_owned();
-            self.violation(
-                rec,
-                id,
-                at,
-                format!(
-                    "error {} ({name}) is not plausible for `{}`",
-                    resp.pwe,
-                    pkw.describe_request(&req)
-                ),
-                ev,
-            );
+            self.violation(rec, id, at, || {
+                (
+                    format!(
+                        "error {} ({name}) is not plausible for `{}`",
+                        resp.pwe,
+                        pkw.describe_request(&req)
+                    ),
+                    ev,
+                )
+            });
         }
     }
 
@@ -1378,16 +1310,10 @@ impl<'s> PsdDrive<'s> {
                 } else {
                     "PSD-REC-007"
                 };
-                self.violation(
-                    rec,
-                    id,
-                    at,
-                    format!(
+                self.violation(rec, id, at, || (format!(
                         "record write of par {index} ({w}) is {} byte(s) long; control byte and value make {need}",
                         data.len()
-                    ),
-                    Evidence::bytes(data).with("index", index),
-                );
+                    ), Evidence::bytes(data).with("index", index)));
                 return;
             }
         }
@@ -1435,18 +1361,17 @@ impl<'s> PsdDrive<'s> {
             } else {
                 "PSD-REC-009"
             };
-            self.violation(
-                rec,
-                id,
-                at,
-                format!(
-                    "record read of par {index} ({w}) answered with {} byte(s), not {need}",
-                    data.len()
-                ),
-                Evidence::bytes(data)
-                    .with("index", index)
-                    .with("data", to_hex(data)),
-            );
+            self.violation(rec, id, at, || {
+                (
+                    format!(
+                        "record read of par {index} ({w}) answered with {} byte(s), not {need}",
+                        data.len()
+                    ),
+                    Evidence::bytes(data)
+                        .with("index", index)
+                        .with("data", to_hex(data)),
+                )
+            });
             return;
         }
         if let Ok(r) = drivespec_psd4xx::RecordRead::parse(&rr, index, data) {

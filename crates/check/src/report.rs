@@ -741,20 +741,35 @@ impl Recorder {
         }
     }
 
-    fn tally(&mut self, id: &str) -> &mut Tally {
-        let catalog = &self.catalog;
-        self.report
-            .requirements
-            .entry(id.to_owned())
-            .or_insert_with(|| {
-                let e = catalog.entry(id);
-                Tally {
-                    level: e.level,
-                    text: e.text,
-                    source: e.source,
-                    violations: 0,
-                }
-            })
+    /// Calls `f` with the tally of requirement `id`, made from the catalogue on first use (the
+    /// key is allocated only then: `checks` runs for every frame).
+    fn with_tally<R>(&mut self, id: &str, f: impl FnOnce(&mut Tally) -> R) -> R {
+        if let Some(t) = self.report.requirements.get_mut(id) {
+            return f(t);
+        }
+        let e = self.catalog.entry(id);
+        let mut t = Tally {
+            level: e.level,
+            text: e.text,
+            source: e.source,
+            violations: 0,
+        };
+        let r = f(&mut t);
+        self.report.requirements.insert(id.to_owned(), t);
+        r
+    }
+
+    fn tally(&mut self, id: &str) {
+        self.with_tally(id, |_| ());
+    }
+
+    /// Whether a violation of `id` recorded now would be listed (not only counted): callers
+    /// with a costly message build it only then.
+    pub fn lists(&self, id: &str) -> bool {
+        self.listed.get(id).copied().unwrap_or(0) < MAX_LISTED_PER_REQUIREMENT
+            && self
+                .max
+                .is_none_or(|m| (self.report.violations.len() as u64) < m)
     }
 
     /// Records a violation of requirement `id`; gives its index in the listing, if listed.
@@ -766,32 +781,40 @@ impl Recorder {
         message: impl Into<String>,
         evidence: Evidence,
     ) -> Option<usize> {
+        self.violation_with(id, subject, at, || (message.into(), evidence))
+    }
+
+    /// [`Recorder::violation`] with the message and evidence made only when the violation is
+    /// listed.
+    pub fn violation_with(
+        &mut self,
+        id: &str,
+        subject: &str,
+        at: Where,
+        detail: impl FnOnce() -> (String, Evidence),
+    ) -> Option<usize> {
         self.report.violation_count += 1;
-        let t = self.tally(id);
-        t.violations += 1;
-        let (level, text, source) = (t.level.clone(), t.text.clone(), t.source.clone());
-        let of_this = self.listed.get(id).copied().unwrap_or(0);
-        if of_this < MAX_LISTED_PER_REQUIREMENT
-            && self
-                .max
-                .is_none_or(|m| (self.report.violations.len() as u64) < m)
-        {
-            *self.listed.entry(id.to_owned()).or_insert(0) += 1;
-            self.report.violations.push(Violation {
-                requirement: id.to_owned(),
-                level,
-                text,
-                source,
-                subject: subject.to_owned(),
-                at,
-                message: message.into(),
-                evidence,
-                end: None,
-                duration_us: None,
-            });
-            return Some(self.report.violations.len() - 1);
+        self.with_tally(id, |t| t.violations += 1);
+        if !self.lists(id) {
+            return None;
         }
-        None
+        let (level, text, source) =
+            self.with_tally(id, |t| (t.level.clone(), t.text.clone(), t.source.clone()));
+        *self.listed.entry(id.to_owned()).or_insert(0) += 1;
+        let (message, evidence) = detail();
+        self.report.violations.push(Violation {
+            requirement: id.to_owned(),
+            level,
+            text,
+            source,
+            subject: subject.to_owned(),
+            at,
+            message,
+            evidence,
+            end: None,
+            duration_us: None,
+        });
+        Some(self.report.violations.len() - 1)
     }
 
     /// Ends the condition of the violation listed at `index` at `end`.
