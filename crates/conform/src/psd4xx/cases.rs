@@ -609,8 +609,9 @@ impl Gen<'_> {
     }
 
     /// One case per parameter the manual marks backed up (table 3.3, column Back-up): a value
-    /// other than the delivery value written, saved with par 96 = 1 (4.7: saving can take up to
-    /// 1 s, the command is repeated until answered), a power cycle, the value read back.
+    /// other than the delivery value written, saved with par 96 = 1, a power cycle, the value
+    /// read back. Judged as the par 96 cases are, by the order of the answers: saving can take
+    /// up to 1 s (4.7), the command is repeated until answered.
     fn backup_cases(&mut self) {
         let params: Vec<&Parameter> = self
             .family
@@ -639,17 +640,7 @@ impl Gen<'_> {
                     value,
                 },
             );
-            self.exchange(
-                &mut steps,
-                Role::Check,
-                "save: par 96 = 1",
-                Request::Write {
-                    pnu: 96,
-                    index: None,
-                    width: Width::Word,
-                    value: 1,
-                },
-            );
+            self.write_pkw(&mut steps, 96, 1);
             steps.push(step(
                 Role::Check,
                 "power cycle",
@@ -673,7 +664,7 @@ impl Gen<'_> {
                 ),
                 PsdCase {
                     steps,
-                    tol: EXCHANGE,
+                    tol: MOTION,
                     plot: false,
                     open: None,
                 },
@@ -1478,7 +1469,12 @@ impl Gen<'_> {
         steps.push(step(Role::Check, "settle", Step::Hold { cycles: 50 }));
         self.push(
             "psd4xx/par96/minus-4/run-command-held".to_owned(),
-            &["PSD-PAR-96-010", "PSD-PAR-96-012", "PSD-PAR-96-003"],
+            &[
+                "PSD-PAR-96-010",
+                "PSD-PAR-96-012",
+                "PSD-PAR-96-003",
+                "PSD-PKW-003",
+            ],
             format!("a run to {AWAY}, then par 96 = -4 with the run command still sent: the drive moves to the middle of the range and stays there"),
             PsdCase {
                 steps,

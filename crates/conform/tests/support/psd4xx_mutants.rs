@@ -64,6 +64,9 @@ pub enum Kind {
     ErrorResetByCommand,
     /// Status bit 15 (negative range limit) is never set.
     LowerLimitBitMissing,
+    /// The speed jumps to 50 rpm when a run starts and from there to 0 when it stops (no
+    /// ramp below 50 rpm).
+    SpeedJumps,
 }
 
 /// The built-in spec with one positioning attempt instead of two (4.2.1), as a drive that
@@ -253,6 +256,11 @@ impl CyclicDevice<'static> for Mutant {
                 }
             }
             Kind::LowerLimitBitMissing => input.status &= !bit("status", "Negative range limit"),
+            Kind::SpeedJumps => {
+                if input.status & bit("status", "Drive is running") != 0 && input.speed != 0 {
+                    input.speed = input.speed.signum() * input.speed.abs().max(50);
+                }
+            }
             Kind::LimitBitsSwapped => {
                 let (up, down) = (
                     bit("status", "Positive range limit"),
@@ -315,7 +323,8 @@ impl CyclicDevice<'static> for Mutant {
                 .parameter("44")
                 .and_then(|p| p.default)
                 .unwrap();
-            self.drive.write_parameter(now, 44, delivery).unwrap();
+            // Out of range after a rescaling (par 38/39): the value stays.
+            let _ = self.drive.write_parameter(now, 44, delivery);
         }
         ok
     }
@@ -526,6 +535,12 @@ pub fn mutants() -> Vec<Case> {
                 "psd4xx/limits/lower/external-force",
             ],
             breaks: &["PSD-STS-15-*"],
+        },
+        Case {
+            kind: SpeedJumps,
+            name: "speed-jumps-without-ramp",
+            must_fail: &["psd4xx/position/loop/up", "psd4xx/speed/changed-during-run"],
+            breaks: &["PSD-VEL-003", "PSD-VEL-004", "PSD-PAR-2-001"],
         },
         Case {
             kind: ObstructionBitMissing,
