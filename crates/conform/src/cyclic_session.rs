@@ -1015,8 +1015,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     /// bit goes through the same changes as the reference's (the order of status events) and
     /// the direction of travel changes as the reference's (approach and reference loop); the
     /// speed stays within the reference's highest (the limits in force) and reaches it where
-    /// the reference cruises at it; wherever both have settled, the exact parts agree and the
-    /// positions are within `tol.position`. The steps with a violation.
+    /// the reference cruises at it, and where the family names ramp requirements no speed
+    /// change per cycle is steeper than the reference's steepest plus [`RAMP_SLACK_PERCENT`];
+    /// wherever both have settled, the exact parts agree and the positions are within
+    /// `tol.position`. The steps with a violation.
     fn judge_motion(
         &self,
         run: &mut Run<'_, 's, F::Input, F::Output>,
@@ -1271,8 +1273,9 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         bad_steps
     }
 
-    /// The requirements a judged run checked: the case's, and in a motion case the rules of
-    /// every status bit whose changes were compared (it changed on the reference).
+    /// The requirements a judged run checked: the case's, and in a motion case the ramp
+    /// requirements where the reference moved and the rules of every status bit whose changes
+    /// were compared (it changed on the reference).
     fn checked(&self, run: &Run<'_, 's, F::Input, F::Output>) -> Vec<String> {
         if !run.evidence.iter().any(|r| r.ok.is_some()) {
             return Vec::new();
