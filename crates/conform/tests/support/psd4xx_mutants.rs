@@ -256,10 +256,10 @@ impl CyclicDevice<'static> for Mutant {
                 }
             }
             Kind::LowerLimitBitMissing => input.status &= !bit("status", "Negative range limit"),
-            Kind::SpeedJumps => {
-                if input.status & bit("status", "Drive is running") != 0 && input.speed != 0 {
-                    input.speed = input.speed.signum() * input.speed.abs().max(50);
-                }
+            Kind::SpeedJumps
+                if input.status & bit("status", "Drive is running") != 0 && input.speed != 0 =>
+            {
+                input.speed = input.speed.signum() * input.speed.abs().max(50);
             }
             Kind::LimitBitsSwapped => {
                 let (up, down) = (
