@@ -14,12 +14,12 @@ speed (big-endian i16), actual position (big-endian i32).
 import struct
 import sys
 
-# pnu: (bits, signed, (min, max) or None, default, writable)
+# pnu: (bits, signed, allowed (min, max) intervals or None, default, writable)
 PARAMS = {
     1: (16, False, None, 0, False),
     3: (32, True, None, 0, False),
-    44: (16, False, (1, 100), 2, True),
-    45: (32, True, (-4000, 4000), 250, True),
+    44: (16, False, [(1, 100)], 2, True),
+    45: (32, True, [(-4000, -10), (0, 0), (10, 4000)], 250, True),
 }
 READ, WRITE_WORD, WRITE_DWORD = 1, 2, 3
 ERR_UNKNOWN, ERR_READ_ONLY, ERR_RANGE, ERR_TYPE, ERR_OTHER = 0, 1, 2, 5, 18
@@ -68,7 +68,7 @@ class Drive:
             value = pwe & 0xFFFF if bits == 16 else pwe
             if signed and value >= 1 << (bits - 1):
                 value -= 1 << bits
-            if rng and not rng[0] <= value <= rng[1]:
+            if rng and not any(lo <= value <= hi for lo, hi in rng):
                 return error(ERR_RANGE)
             self.values[pnu] = value
             return (1 if bits == 16 else 2, pnu, ind, pwe)
@@ -114,7 +114,7 @@ class Drive:
         value = int.from_bytes(data[1:], "big", signed=signed)
         if data[0] == 0:
             return "IGNORED"
-        if rng and not rng[0] <= value <= rng[1]:
+        if rng and not any(lo <= value <= hi for lo, hi in rng):
             return "REFUSED 2"
         self.values[index] = value
         return "WRITTEN"

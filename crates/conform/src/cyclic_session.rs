@@ -280,6 +280,46 @@ pub trait CyclicFamily<'s> {
     fn open(_case: &Self::Case) -> Option<OpenPoint> {
         None
     }
+    /// The requirements bounding a run's speed change (acceleration, deceleration), which a
+    /// motion case checks against the reference's steepest change per cycle
+    /// ([`RAMP_SLACK_PERCENT`]). By default none: the ramps are not judged.
+    fn ramp_requirements(&self) -> Option<[&'static str; 2]> {
+        None
+    }
+}
+
+/// How much steeper than the reference's steepest speed change per cycle a device's may be,
+/// %: the reference ramps at the acceleration and deceleration in force; a device's speed
+/// samples round to whole rpm, and on real time two cycles may fall closer together or
+/// further apart than the nominal cycle. The check catches a ramp that ignores the limit,
+/// not one that differs from the reference's shape.
+const RAMP_SLACK_PERCENT: i64 = 50;
+
+/// The steepest speed-up and slow-down per cycle (rpm) of a run's speeds, a sign change
+/// counted as slowing to 0 and speeding up from it.
+fn steepest(speeds: impl Iterator<Item = Option<i64>>) -> (i64, i64, Option<usize>, Option<usize>) {
+    let (mut up, mut down, mut up_at, mut down_at) = (0i64, 0i64, None, None);
+    let mut last: Option<i64> = None;
+    for (i, v) in speeds.enumerate() {
+        if let (Some(a), Some(b)) = (last, v) {
+            let (slow, fast) = if a.signum() * b.signum() < 0 {
+                (a.abs(), b.abs())
+            } else {
+                (
+                    a.abs().saturating_sub(b.abs()).max(0),
+                    b.abs().saturating_sub(a.abs()).max(0),
+                )
+            };
+            if fast > up {
+                (up, up_at) = (fast, Some(i));
+            }
+            if slow > down {
+                (down, down_at) = (slow, Some(i));
+            }
+        }
+        last = v;
+    }
+    (up, down, up_at, down_at)
 }
 
 /// The peer of the device under test `dut`; `sim` is the reference server of `model`, built
@@ -979,8 +1019,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
     /// bit goes through the same changes as the reference's (the order of status events) and
     /// the direction of travel changes as the reference's (approach and reference loop); the
     /// speed stays within the reference's highest (the limits in force) and reaches it where
-    /// the reference cruises at it; wherever both have settled, the exact parts agree and the
-    /// positions are within `tol.position`. The steps with a violation.
+    /// the reference cruises at it, and where the family names ramp requirements no speed
+    /// change per cycle is steeper than the reference's steepest plus [`RAMP_SLACK_PERCENT`];
+    /// wherever both have settled, the exact parts agree and the positions are within
+    /// `tol.position`. The steps with a violation.
     fn judge_motion(
         &self,
         run: &mut Run<'_, 's, F::Input, F::Output>,
@@ -1139,6 +1181,41 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 format!("the highest speed is {v} rpm; the speed in force is {top} rpm (at least {floor} rpm)"),
             ));
         }
+        // The ramps: no speed change per cycle steeper than the reference's plus slack.
+        if let Some([accel, decel]) = self.family.ramp_requirements() {
+            let (up, down, _, _) =
+                steepest(run.cycles.iter().map(|c| Some(F::motion(&c.reference).1)));
+            let (dev_up, dev_down, up_at, down_at) = steepest(
+                run.cycles
+                    .iter()
+                    .map(|c| c.dut.as_ref().ok().map(|d| F::motion(d).1)),
+            );
+            let bound = |r: i64| {
+                r.saturating_mul(100 + RAMP_SLACK_PERCENT)
+                    .saturating_div(100)
+                    .saturating_add(2 * tol.speed)
+            };
+            for (what, req, theirs, mine, at) in [
+                ("speeds up", accel, up, dev_up, up_at),
+                ("slows down", decel, down, dev_down, down_at),
+            ] {
+                if let Some(i) = at.filter(|_| theirs > 0 && mine > bound(theirs)) {
+                    bad.push(
+                        Finding::at(
+                            i,
+                            run.cycles.get(i).map_or(0, |c| c.step),
+                            None,
+                            format!(
+                                "the speed {what} by {mine} rpm in one cycle; at most {} rpm (the steepest in force, {theirs} rpm, plus {RAMP_SLACK_PERCENT} % and {} rpm)",
+                                bound(theirs),
+                                2 * tol.speed
+                            ),
+                        )
+                        .breaking(vec![req.to_owned()]),
+                    );
+                }
+            }
+        }
         // Settled on both sides: exact parts equal, positions within the tolerance.
         let cycle_us = self.family.cycle_us();
         let bit = self.family.running_bit();
@@ -1201,13 +1278,26 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         bad_steps
     }
 
-    /// The requirements a judged run checked: the case's, and in a motion case the rules of
-    /// every status bit whose changes were compared (it changed on the reference).
+    /// The requirements a judged run checked: the case's, and in a motion case the ramp
+    /// requirements where the reference moved and the rules of every status bit whose changes
+    /// were compared (it changed on the reference).
     fn checked(&self, run: &Run<'_, 's, F::Input, F::Output>) -> Vec<String> {
         if !run.evidence.iter().any(|r| r.ok.is_some()) {
             return Vec::new();
         }
         let mut ids = run.reqs.to_vec();
+        let moved = run.cycles.iter().any(|c| F::motion(&c.reference).1 != 0);
+        if let Some(ramps) = self
+            .family
+            .ramp_requirements()
+            .filter(|_| run.tol.motion && moved)
+        {
+            for id in ramps {
+                if !ids.iter().any(|x| x == id) {
+                    ids.push(id.to_owned());
+                }
+            }
+        }
         if run.tol.motion {
             let words: Vec<u16> = run
                 .cycles

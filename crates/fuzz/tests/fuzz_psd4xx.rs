@@ -54,10 +54,20 @@ fn mutant(kind: Kind, name: &str) -> Device {
 const LIMIT: usize = 5;
 
 /// Mutants whose deviation a random run of this bound cannot reach, each caught by the suite
-/// instead: swapped limit bits show only when a manual run reaches an end limit (805,200
-/// increments at delivery), which `psd4xx/sequence/seq-manual-run-to-upper-limit` reaches by
-/// lowering par 42 first.
-const BEYOND_REACH: &[&str] = &["limit-bits-swapped"];
+/// instead: swapped limit bits and a missing lower-limit bit show only when the drive stands
+/// beyond an end limit (805,200 increments at delivery), which the suite's limit cases reach by
+/// moving par 42 or 43 first; the temperature and error bits need injections the generator
+/// sends only with harmless values (25 °C) or not at all (a position fault), which
+/// `psd4xx/status/temperature` and `psd4xx/status/position-fault` send; a par 44 lost at a
+/// power cycle shows only when one sequence writes par 44, saves, power-cycles and reads it
+/// back, which this bound does not reach and `psd4xx/pkw/backup/44` does.
+const BEYOND_REACH: &[&str] = &[
+    "limit-bits-swapped",
+    "lower-limit-bit-missing",
+    "temperature-bit-without-hysteresis",
+    "error-bit-reset-by-a-command",
+    "window-not-backed-up",
+];
 
 #[test]
 fn every_psd4xx_mutant_is_found_with_a_short_replay() {

@@ -29,6 +29,163 @@ pub const EXCHANGE: Tolerance = Tolerance {
     motion: false,
 };
 
+/// The requirements that state a parameter's row of tables 3.3 and 3.4 (data type, range,
+/// delivery value, back-up), by parameter number: each is judged by the parameter's reads
+/// (the delivery value exactly, or type and length where the manual gives an example), its
+/// writes at the range edges and in the gaps of the range, and its back-up case.
+const ROW: &[(u32, &[&str])] = &[
+    (1, &["PSD-PAR-1-001"]),
+    (2, &["PSD-PAR-2-001"]),
+    (3, &["PSD-PAR-3-001", "PSD-MAP-003"]),
+    (4, &["PSD-PAR-4-001"]),
+    (5, &["PSD-PAR-5-001"]),
+    (6, &["PSD-PAR-6-001"]),
+    (7, &["PSD-PAR-7-001"]),
+    (8, &["PSD-PAR-8-001"]),
+    (9, &["PSD-PAR-9-001"]),
+    (10, &["PSD-PAR-10-001"]),
+    (11, &["PSD-PAR-11-001"]),
+    (12, &["PSD-PAR-12-001"]),
+    (14, &["PSD-PAR-14-001"]),
+    (32, &["PSD-PAR-32-002", "PSD-PAR-DELIVERY-001"]),
+    (33, &["PSD-PAR-33-002", "PSD-PAR-DELIVERY-001"]),
+    (37, &["PSD-PAR-37-002", "PSD-PAR-DELIVERY-001"]),
+    (
+        38,
+        &["PSD-PAR-38-001", "PSD-MAP-025", "PSD-PAR-DELIVERY-001"],
+    ),
+    (
+        39,
+        &["PSD-PAR-38-001", "PSD-MAP-025", "PSD-PAR-DELIVERY-001"],
+    ),
+    (40, &["PSD-PAR-40-001", "PSD-PAR-DELIVERY-001"]),
+    (
+        41,
+        &[
+            "PSD-PAR-41-003",
+            "PSD-MODEL-P41",
+            "PSD-MAP-006",
+            "PSD-MAP-029",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        42,
+        &[
+            "PSD-PAR-41-003",
+            "PSD-MODEL-P42",
+            "PSD-MAP-003",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        43,
+        &[
+            "PSD-PAR-41-003",
+            "PSD-MODEL-P43",
+            "PSD-MAP-003",
+            "PSD-MAP-029",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (44, &["PSD-PAR-44-002", "PSD-PAR-DELIVERY-001"]),
+    (45, &["PSD-PAR-45-003", "PSD-PAR-DELIVERY-001"]),
+    (47, &["PSD-PAR-47-001", "PSD-PAR-DELIVERY-001"]),
+    (
+        53,
+        &[
+            "PSD-PAR-53-001",
+            "PSD-MODEL-P53",
+            "PSD-PAR-MODEL-001",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        56,
+        &[
+            "PSD-PAR-56-001",
+            "PSD-MODEL-P56",
+            "PSD-PAR-MODEL-001",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (57, &["PSD-PAR-57-001", "PSD-PAR-DELIVERY-001"]),
+    (
+        58,
+        &[
+            "PSD-PAR-58-001",
+            "PSD-MODEL-P58",
+            "PSD-PAR-MODEL-001",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        59,
+        &[
+            "PSD-PAR-59-001",
+            "PSD-MODEL-P59",
+            "PSD-PAR-MODEL-001",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        63,
+        &[
+            "PSD-PAR-63-001",
+            "PSD-MODEL-P63",
+            "PSD-PAR-MODEL-001",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        64,
+        &["PSD-MODEL-P64", "PSD-PAR-MODEL-001", "PSD-PAR-DELIVERY-001"],
+    ),
+    (
+        65,
+        &[
+            "PSD-PAR-65-001",
+            "PSD-MODEL-P65",
+            "PSD-PAR-MODEL-001",
+            "PSD-PAR-DELIVERY-001",
+        ],
+    ),
+    (
+        66,
+        &["PSD-MODEL-P66", "PSD-PAR-MODEL-001", "PSD-PAR-DELIVERY-001"],
+    ),
+    (70, &["PSD-PAR-70-001", "PSD-PAR-DELIVERY-001"]),
+    (71, &["PSD-PAR-71-001", "PSD-PAR-DELIVERY-001"]),
+    (72, &["PSD-PAR-72-001", "PSD-PAR-DELIVERY-001"]),
+    (76, &["PSD-PAR-76-001", "PSD-PAR-DELIVERY-001"]),
+    (80, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (81, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (82, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (83, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (84, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (85, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (86, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (87, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (88, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (89, &["PSD-PAR-80-001", "PSD-PAR-DELIVERY-001"]),
+    (90, &["PSD-PAR-90-001", "PSD-PAR-DELIVERY-001"]),
+    (91, &["PSD-PAR-91-001", "PSD-PAR-DELIVERY-001"]),
+];
+
+/// The row requirements of parameter `number` ([`ROW`]).
+fn row(number: u32) -> &'static [&'static str] {
+    ROW.iter()
+        .find(|(n, _)| *n == number)
+        .map_or(&[], |(_, r)| r)
+}
+
+/// `reqs` followed by the row requirements of parameter `number`.
+fn with_row<'a>(reqs: &[&'a str], number: u32) -> Vec<&'a str> {
+    let mut all = reqs.to_vec();
+    all.extend_from_slice(row(number));
+    all
+}
+
 /// A generated case.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PsdCase {
@@ -240,6 +397,7 @@ impl Gen<'_> {
             if Self::width(p) == Some(Width::Word) {
                 reqs.push("PSD-PKW-038");
             }
+            reqs.extend_from_slice(row(num));
             self.push(
                 format!("psd4xx/pkw/read/{num}"),
                 &reqs,
@@ -292,13 +450,14 @@ impl Gen<'_> {
                 continue;
             };
             let (tlo, thi) = p.data_type.bounds().unwrap_or((i64::MIN, i64::MAX));
-            let mut edges = vec![("min", min, true), ("max", max, true)];
+            let mut edges = vec![("min".to_owned(), min, true), ("max".to_owned(), max, true)];
             if min > tlo {
-                edges.push(("below-min", min - 1, false));
+                edges.push(("below-min".to_owned(), min - 1, false));
             }
             if max < thi {
-                edges.push(("above-max", max + 1, false));
+                edges.push(("above-max".to_owned(), max + 1, false));
             }
+            edges.extend(self.gaps(p));
             for (name, value, ok) in edges {
                 let mut steps = Vec::new();
                 self.exchange(
@@ -334,7 +493,7 @@ impl Gen<'_> {
                 };
                 self.push(
                     format!("psd4xx/pkw/write/{num}/{name}"),
-                    reqs,
+                    &with_row(reqs, num),
                     format!(
                         "write {value} to par {num} ({}) on {}",
                         p.name, self.model.id
@@ -408,6 +567,104 @@ impl Gen<'_> {
                 PsdCase {
                     steps,
                     tol: EXCHANGE,
+                    plot: false,
+                    open: None,
+                },
+            );
+        }
+    }
+
+    /// The values around each gap of a range of several intervals (par 45: -9 … 9 but 0):
+    /// the inner edges are accepted, the values just inside a gap refused (error 2).
+    fn gaps(&self, p: &Parameter) -> Vec<(String, i64, bool)> {
+        let Some(r) = self.family.resolve(p, Some(self.model)).range else {
+            return Vec::new();
+        };
+        let name = |what: &str, v: i64| {
+            if v < 0 {
+                format!("{what}-minus-{}", v.unsigned_abs())
+            } else {
+                format!("{what}-{v}")
+            }
+        };
+        let mut intervals = r.intervals().to_vec();
+        intervals.sort_unstable();
+        let mut out = Vec::new();
+        for w in intervals.windows(2) {
+            let [[_, below], [above, _]] = *w else {
+                continue;
+            };
+            if above.saturating_sub(below) < 2 {
+                continue;
+            }
+            out.push((name("edge", below), below, true));
+            out.push((name("gap", below + 1), below + 1, false));
+            if above - 1 > below + 1 {
+                out.push((name("gap", above - 1), above - 1, false));
+            }
+            out.push((name("edge", above), above, true));
+        }
+        out.dedup_by_key(|(n, _, _)| n.clone());
+        out
+    }
+
+    /// One case per parameter the manual marks backed up (table 3.3, column Back-up): a value
+    /// other than the delivery value written, saved with par 96 = 1, a power cycle, the value
+    /// read back. Judged as the par 96 cases are, by the order of the answers: saving can take
+    /// up to 1 s (4.7), the command is repeated until answered.
+    fn backup_cases(&mut self) {
+        let params: Vec<&Parameter> = self
+            .family
+            .parameters
+            .iter()
+            .filter(|p| p.saved == Some(true) && p.access.writable() && p.number != 96)
+            .collect();
+        for p in params {
+            let (Ok(pnu), Some(width), Some((min, max))) =
+                (u16::try_from(p.number), Self::width(p), self.range(p))
+            else {
+                continue;
+            };
+            let num = p.number;
+            let default = self.family.resolve(p, Some(self.model)).default;
+            let value = if default == Some(max) { min } else { max };
+            let mut steps = Vec::new();
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("write par {num} = {value}"),
+                Request::Write {
+                    pnu,
+                    index: None,
+                    width,
+                    value,
+                },
+            );
+            self.write_pkw(&mut steps, 96, 1);
+            steps.push(step(
+                Role::Check,
+                "power cycle",
+                Step::Env {
+                    env: Env::PowerCycle.to_string(),
+                },
+            ));
+            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 5 }));
+            self.exchange(
+                &mut steps,
+                Role::Check,
+                &format!("read par {num} after power-up"),
+                Request::Read { pnu, index: None },
+            );
+            self.push(
+                format!("psd4xx/pkw/backup/{num}"),
+                &with_row(&["PSD-PAR-SAVE-001", "PSD-PAR-96-007"], num),
+                format!(
+                    "par {num} ({}) = {value}, saved, power cycle: the value is kept",
+                    p.name
+                ),
+                PsdCase {
+                    steps,
+                    tol: MOTION,
                     plot: false,
                     open: None,
                 },
@@ -633,7 +890,7 @@ impl Gen<'_> {
             };
             self.push(
                 format!("psd4xx/record/read/{num}"),
-                read_reqs,
+                &with_row(read_reqs, num),
                 format!("read record {num} ({})", p.name),
                 PsdCase {
                     steps: vec![step(
@@ -1159,6 +1416,78 @@ impl Gen<'_> {
                 },
             );
         }
+        self.par96_centre_case(run_bits)
+    }
+
+    /// The move to the middle of the range (par 96 = -4) away from a target reached by a run
+    /// while the controller goes on sending that run command: the unchanged control word is
+    /// ignored (PSD-PAR-96-010) and the old target is not approached again afterwards
+    /// (PSD-PAR-96-012). The working values are saved first, so -4 restores them.
+    fn par96_centre_case(&mut self, run_bits: u16) -> Result<(), String> {
+        /// The target of the run before par 96 = -4 (increments), away from the middle.
+        const AWAY: i32 = 4000;
+        let run = control(self.family, "release-and-transfer")?;
+        let mut steps = Vec::new();
+        self.write_pkw(&mut steps, 96, 1);
+        steps.push(step(
+            Role::Setup,
+            format!("control {run:#06x}, target {AWAY}"),
+            Step::Process {
+                control: Some(run),
+                target: Some(AWAY),
+            },
+        ));
+        for (text, running) in [("until running", true), ("until standstill", false)] {
+            steps.push(step(
+                Role::Setup,
+                text,
+                Step::Until {
+                    running,
+                    max: 12_000,
+                },
+            ));
+        }
+        self.exchange(
+            &mut steps,
+            Role::Check,
+            "write par 96 = -4, the run command still sent",
+            Request::Write {
+                pnu: 96,
+                index: None,
+                width: Width::Word,
+                value: -4,
+            },
+        );
+        steps.push(step(
+            Role::Check,
+            "until standstill",
+            Step::Until {
+                running: false,
+                max: 12_000,
+            },
+        ));
+        steps.push(step(Role::Check, "settle", Step::Hold { cycles: 50 }));
+        self.push(
+            "psd4xx/par96/minus-4/run-command-held".to_owned(),
+            &[
+                "PSD-PAR-96-010",
+                "PSD-PAR-96-012",
+                "PSD-PAR-96-003",
+                "PSD-PKW-003",
+            ],
+            format!("a run to {AWAY}, then par 96 = -4 with the run command still sent: the drive moves to the middle of the range and stays there"),
+            PsdCase {
+                steps,
+                tol: MOTION,
+                plot: true,
+                open: Some(OpenPoint {
+                    requirement: "PSD-PAR-96-003".to_owned(),
+                    text: "par 96 = -4: the manual does not say whether the move to the middle of the range is a run (the status bits of a run, a reference loop)".to_owned(),
+                    bits: run_bits,
+                    movement: true,
+                }),
+            },
+        );
         Ok(())
     }
 }
@@ -1180,6 +1509,7 @@ pub(crate) fn generate(
     };
     g.pkw_cases();
     g.pkw_rules_cases();
+    g.backup_cases();
     g.standstill_cases()?;
     g.umot_limit_case()?;
     g.record_cases()?;

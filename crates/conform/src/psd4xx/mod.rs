@@ -6,12 +6,13 @@
 //!
 //! | group | what |
 //! | --- | --- |
-//! | `pkw` | every parameter read; writes at both range edges and one beyond; read-only writes (error 1); unknown PNUs (error 0); standstill-only writes during a run (error 17); par. 13 segments and count; "no command"/"no response"; the response held until the next command; every error code |
+//! | `pkw` | every parameter read; writes at both range edges, one beyond and around each gap of the range; back-up across a power cycle; read-only writes (error 1); unknown PNUs (error 0); standstill-only writes during a run (error 17); par. 13 segments and count; "no command"/"no response"; the response held until the next command; every error code |
 //! | `record` | every parameter read (2/4 bytes, the string); writes of 3/5 bytes with control byte 1, ignored with control byte 0, wrong lengths, unknown indices |
 //! | `sequence` | the spec's `sequence` vectors, step for step |
 //! | `position` | positioning with and without loop in both directions, manual runs, release withdrawal, a new target during a run |
 //! | `status` | status bits after power-on, at the target, toggle echo, obstruction, incorrect target, the motor voltage at the UMot limit |
-//! | `par96` | every par. 96 command and rejected values, with a power cycle after |
+//! | `par96` | every par. 96 command and rejected values, with a power cycle after; -4 with the run command still sent |
+//! | `limits`, `window`, `mapping`, `torque`, `speed`, `image` | the scenario files: end-limit bits, the positioning window, the mapping and scaling of 4.7/4.8, torque limits, a speed change during a run, the process image layout |
 //!
 //! Every cycle's input image of the device under test is compared with the reference's: PKW
 //! block and status word exactly, position and speed within the case's declared tolerance, a

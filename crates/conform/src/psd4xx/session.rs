@@ -206,6 +206,11 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         status_bit(self.suite.family(), "Drive is running").unwrap_or(0)
     }
 
+    /// 4.3: all runs accelerate with at most par 58 and decelerate with at most par 59.
+    fn ramp_requirements(&self) -> Option<[&'static str; 2]> {
+        Some(["PSD-VEL-003", "PSD-VEL-004"])
+    }
+
     /// The case's requirements plus those of what differs in a cycle: the PKW handshake
     /// rules (3.6: response held, value of the moment, command 0 answered with 0, one command
     /// at a time) when the PKW block differs, the speed (par. 2) and position (par. 3) rules

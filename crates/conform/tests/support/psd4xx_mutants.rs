@@ -55,6 +55,18 @@ pub enum Kind {
     LimitBitsSwapped,
     /// A run that ends outside the positioning window is not repeated: one attempt only.
     NoSecondPositioning,
+    /// Par 44 is not kept in EEPROM: after a power cycle it has its delivery value again.
+    WindowNotBackedUp,
+    /// Status bit 7 is reset as soon as the temperature is no longer above par 91 (no 5 °C
+    /// hysteresis).
+    TemperatureWithoutHysteresis,
+    /// Status bit 9 is reset by the next change of the control word instead of a reset only.
+    ErrorResetByCommand,
+    /// Status bit 15 (negative range limit) is never set.
+    LowerLimitBitMissing,
+    /// The speed jumps to 50 rpm when a run starts and from there to 0 when it stops (no
+    /// ramp below 50 rpm).
+    SpeedJumps,
 }
 
 /// The built-in spec with one positioning attempt instead of two (4.2.1), as a drive that
@@ -83,6 +95,12 @@ pub struct Mutant {
     target_in_force: i32,
     /// The target last transferred (control bit 2), if any.
     transferred: Option<i32>,
+    /// The device temperature last injected (°C).
+    temperature: Option<i16>,
+    /// Whether the control word changed since the last position fault.
+    error_cleared: bool,
+    /// The control word last received.
+    last_control: u16,
 }
 
 impl Mutant {
@@ -103,6 +121,9 @@ impl Mutant {
             running: false,
             target_in_force: 0,
             transferred: None,
+            temperature: None,
+            error_cleared: false,
+            last_control: 0,
         }
     }
 }
@@ -220,6 +241,26 @@ impl CyclicDevice<'static> for Mutant {
                     }
                 }
             }
+            Kind::TemperatureWithoutHysteresis => {
+                let limit = self.drive.parameter(91).unwrap_or(80);
+                if self.temperature.is_some_and(|c| i64::from(c) <= limit) {
+                    input.status &= !bit("status", "Temperature too high");
+                }
+            }
+            Kind::ErrorResetByCommand => {
+                if original.control != self.last_control {
+                    self.error_cleared = true;
+                }
+                if self.error_cleared {
+                    input.status &= !bit("status", "Error");
+                }
+            }
+            Kind::LowerLimitBitMissing => input.status &= !bit("status", "Negative range limit"),
+            Kind::SpeedJumps
+                if input.status & bit("status", "Drive is running") != 0 && input.speed != 0 =>
+            {
+                input.speed = input.speed.signum() * input.speed.abs().max(50);
+            }
             Kind::LimitBitsSwapped => {
                 let (up, down) = (
                     bit("status", "Positive range limit"),
@@ -232,6 +273,7 @@ impl CyclicDevice<'static> for Mutant {
             _ => {}
         }
         self.running = input.status & bit("status", "Drive is running") != 0;
+        self.last_control = original.control;
         self.last_pkw = Some(original.pkw);
         if original.pkw != PkwRequest::default() {
             self.last_response = Some(input.pkw);
@@ -269,7 +311,22 @@ impl CyclicDevice<'static> for Mutant {
     }
 
     fn env(&mut self, now: Micros, env: Env) -> bool {
-        self.drive.env(now, env)
+        match env {
+            Env::Temperature(c) => self.temperature = Some(c),
+            Env::PositionFault => self.error_cleared = false,
+            _ => {}
+        }
+        let ok = self.drive.env(now, env);
+        if self.kind == Kind::WindowNotBackedUp && env == Env::PowerCycle {
+            let delivery = spec()
+                .family(FamilyId::Psd4xx)
+                .parameter("44")
+                .and_then(|p| p.default)
+                .unwrap();
+            // Out of range after a rescaling (par 38/39): the value stays.
+            let _ = self.drive.write_parameter(now, 44, delivery);
+        }
+        ok
     }
 
     fn clone_box(&self) -> Box<dyn CyclicDevice<'static>> {
@@ -360,6 +417,7 @@ pub fn mutants() -> Vec<Case> {
             must_fail: &[
                 "psd4xx/pkw/write/44/above-max",
                 "psd4xx/pkw/write/45/below-min",
+                "psd4xx/pkw/write/45/gap-1",
             ],
             breaks: &[
                 "PSD-PAR-RANGE-001",
@@ -449,6 +507,40 @@ pub fn mutants() -> Vec<Case> {
             name: "no-second-positioning",
             must_fail: &["psd4xx/sequence/seq-second-positioning"],
             breaks: &["PSD-POS-013", "PSD-POS-014", "PSD-STS-10-*", "PSD-STS-0-*"],
+        },
+        Case {
+            kind: WindowNotBackedUp,
+            name: "window-not-backed-up",
+            must_fail: &["psd4xx/pkw/backup/44", "psd4xx/par96/1"],
+            breaks: &["PSD-PAR-SAVE-001", "PSD-PAR-96-*", "PSD-PAR-44-002"],
+        },
+        Case {
+            kind: TemperatureWithoutHysteresis,
+            name: "temperature-bit-without-hysteresis",
+            must_fail: &["psd4xx/status/temperature"],
+            breaks: &["PSD-STS-7-*"],
+        },
+        Case {
+            kind: ErrorResetByCommand,
+            name: "error-bit-reset-by-a-command",
+            must_fail: &["psd4xx/status/position-fault"],
+            breaks: &["PSD-STS-9-*"],
+        },
+        Case {
+            kind: LowerLimitBitMissing,
+            name: "lower-limit-bit-missing",
+            must_fail: &[
+                "psd4xx/limits/lower/manual-run",
+                "psd4xx/limits/lower/changed",
+                "psd4xx/limits/lower/external-force",
+            ],
+            breaks: &["PSD-STS-15-*"],
+        },
+        Case {
+            kind: SpeedJumps,
+            name: "speed-jumps-without-ramp",
+            must_fail: &["psd4xx/position/loop/up", "psd4xx/speed/changed-during-run"],
+            breaks: &["PSD-VEL-003", "PSD-VEL-004", "PSD-PAR-2-001"],
         },
         Case {
             kind: ObstructionBitMissing,
