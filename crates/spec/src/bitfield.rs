@@ -46,6 +46,10 @@ pub struct BitRule {
     /// Remark on the requirement.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// Why no check over the interface can see the requirement; given, the requirement is
+    /// not observable (as `observable = false` with `reason` on a `[[requirement]]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 impl BitRule {
@@ -244,8 +248,8 @@ pub(crate) fn rule_requirements(bitfields: &[Bitfield]) -> Vec<Requirement> {
                         .unwrap_or_else(|| format!("{} bit {}", b.section(), bit.bit)),
                     params: rule.params.clone(),
                     note: rule.note.clone(),
-                    observable: true,
-                    reason: None,
+                    observable: rule.reason.is_none(),
+                    reason: rule.reason.clone(),
                     file: b.file.clone(),
                 });
             }

@@ -637,6 +637,7 @@ fn restated(rule: &crate::BitRule, level: Level) -> Option<String> {
         ("source", rule.source.is_some()),
         ("params", !rule.params.is_empty()),
         ("note", rule.note.is_some()),
+        ("reason", rule.reason.is_some()),
     ];
     keys.iter().find(|(_, set)| *set).map(|(key, _)| {
         format!("`{key}` for requirement {id:?}, which an earlier rule already states")

@@ -146,7 +146,7 @@ fn the_manuals_worked_examples_are_all_there() {
         );
     }
     assert_eq!(kind_count(hpd, VectorKind::HpdFrame), 17);
-    assert_eq!(kind_count(hpd, VectorKind::HpdPlc), 47);
+    assert_eq!(kind_count(hpd, VectorKind::HpdPlc), 58);
     assert_eq!(kind_count(hpd, VectorKind::HpdPlcBytes), 7);
     assert_eq!(kind_count(hpd, VectorKind::Formula), 29);
     let psd = spec.family(FamilyId::Psd4xx);
@@ -175,7 +175,7 @@ fn counts_per_manual() {
             should: 19,
             informative: 53,
             errata: 39,
-            vectors: 100
+            vectors: 111
         }
     );
     assert_eq!(

@@ -20,6 +20,8 @@ pub(crate) fn generate(g: &mut Gen) {
     baud(g);
     vectors(g);
     plc_vectors(g);
+    timers(g);
+    power_up(g);
 }
 
 /// Another address than the device's own, picked by the seed.
@@ -1083,8 +1085,12 @@ fn plc_vectors(g: &mut Gen) {
             t.iter().flat_map(|t| t.keys().cloned()).collect()
         };
         let params = table(&body.input.params);
-        let bits = table(&body.input.bits);
-        // Everything set must be writable over the line.
+        // The physical inputs (b90.0..b90.7, manual 3.8.1) are applied as inputs; the
+        // transport must be able to drive them.
+        let (inputs, bits): (Vec<_>, Vec<_>) = table(&body.input.bits)
+            .into_iter()
+            .partition(|(k, _)| physical_input(g, k).is_some());
+        // Everything else set must be writable over the line.
         let settable = params.iter().all(|(k, _)| {
             g.param(k)
                 .is_some_and(|p| p.access.writable() && p.address.is_some())
@@ -1127,6 +1133,24 @@ fn plc_vectors(g: &mut Gen) {
                     restore.push(r.slot);
                 }
             }
+        }
+        let start_inputs = g.baseline.digital_inputs();
+        if !inputs.is_empty() {
+            // The results depend on the drive reading its inputs into b90.0..b90.7.
+            cb.reqs(["HPD-BIT-90-INPUTS".to_owned()]);
+            let mut value = start_inputs;
+            for (k, val) in &inputs {
+                if let Some(i) = physical_input(g, k) {
+                    let b = 1u16.checked_shl(u32::from(i)).unwrap_or(0);
+                    value = if *val != 0 { value | b } else { value & !b };
+                }
+            }
+            cb.action(
+                Role::Setup,
+                Action::Inputs { value },
+                format!("apply the digital inputs {value:#06x}"),
+                &["HPD-BIT-90-INPUTS"],
+            );
         }
         let Some(run) = g.bit_ref(&run_name) else {
             continue;
@@ -1173,10 +1197,187 @@ fn plc_vectors(g: &mut Gen) {
             }
         }
         upload(g, &mut cb, Role::Cleanup, first, &original);
+        if !inputs.is_empty() {
+            cb.action(
+                Role::Cleanup,
+                Action::Inputs {
+                    value: start_inputs,
+                },
+                "the digital inputs as at the start",
+                &[],
+            );
+        }
         for s in restore {
             g.restore(&mut cb, s, "what the program or the vector changed");
         }
         g.restore_pb99(&mut cb);
         g.push(cb);
     }
+}
+
+/// The digital input a bit name stands for (`b90.3` is input 3), when it is one of the
+/// physical inputs (manual 3.8.1 b90.0..b90.7, the spec's PLC inputs table).
+fn physical_input(g: &Gen, name: &str) -> Option<u8> {
+    g.protocol
+        .io
+        .inputs
+        .iter()
+        .find(|p| p.bit == name)
+        .map(|p| p.index)
+}
+
+/// The two PLC timers (manual 3.8.1 Pr92, Pr93, b99.0, b99.1): loaded over the line with
+/// the PLC running, each counts one per 6.144 ms scan and raises its flag once it reaches
+/// 0. The reads fall at least ten scans away from either expiry, so the scan phase and the
+/// answer time do not decide them; counts are compared within ± `TIMER_SLACK_SCANS`.
+fn timers(g: &mut Gen) {
+    let timers = g.protocol.plc.timers.clone();
+    let (Some(t1), Some(t2)) = (timers.first(), timers.get(1)) else {
+        return;
+    };
+    let (Some(s1), Some(s2), Some(f1), Some(f2)) = (
+        g.slot_of(&t1.param),
+        g.slot_of(&t2.param),
+        g.bit_ref(&t1.status_bit),
+        g.bit_ref(&t2.status_bit),
+    ) else {
+        return;
+    };
+    // Timer 1 runs 100 scans (about 614 ms, the manual's example), timer 2 half as long.
+    let (n1, n2) = (100i64, 50i64);
+    let scan = u64::from(t1.base_us);
+    let flags = Compare::Mask(bit_value(f1.slot, f1.at) | bit_value(f2.slot, f2.at));
+    let near = Compare::Near(TIMER_SLACK_SCANS);
+    let mut cb = CaseB::new(
+        "hpd/plc/timers",
+        format!(
+            "{} = {n1} and {} = {n2} count one per scan: both flags 0 while counting, {} = 0 with {} = 1 after {n2} scans, {} = 0 with {} = 1 after {n1}",
+            t1.param, t2.param, t2.param, t2.status_bit, t1.param, t1.status_bit
+        ),
+        &[
+            "HPD-TIMER-001",
+            "HPD-TIMER-002",
+            "HPD-TIMER-003",
+            "HPD-TIMER-004",
+        ],
+    );
+    let (p1, p2) = (t1.param.clone(), t2.param.clone());
+    g.write(&mut cb, Role::Check, s1, n1, &p1);
+    g.write(&mut cb, Role::Check, s2, n2, &p2);
+    g.read(
+        &mut cb,
+        Role::Check,
+        f1.slot,
+        flags,
+        "Pb99 (both timers counting)",
+    );
+    // The read at about 25 scans, half-way through timer 2.
+    cb.action(
+        Role::Check,
+        Action::Listen { us: 25 * scan },
+        "listen for 25 scans",
+        &[],
+    );
+    g.read(&mut cb, Role::Check, s2, near, &p2);
+    g.read(&mut cb, Role::Check, s1, near, &p1);
+    // At about 65 scans: timer 2 has elapsed, timer 1 still counts.
+    cb.action(
+        Role::Check,
+        Action::Listen { us: 40 * scan },
+        "listen for 40 more scans",
+        &[],
+    );
+    g.read(&mut cb, Role::Check, s2, Compare::Exact, &p2);
+    g.read(
+        &mut cb,
+        Role::Check,
+        f1.slot,
+        flags,
+        "Pb99 (timer 2 elapsed)",
+    );
+    // At about 125 scans: both have elapsed.
+    cb.action(
+        Role::Check,
+        Action::Listen { us: 60 * scan },
+        "listen for 60 more scans",
+        &[],
+    );
+    g.read(&mut cb, Role::Check, s1, Compare::Exact, &p1);
+    g.read(&mut cb, Role::Check, f1.slot, flags, "Pb99 (both elapsed)");
+    g.restore(&mut cb, s1, &p1);
+    g.restore(&mut cb, s2, &p2);
+    g.push(cb);
+}
+
+/// How many scans a timer count read over the line may differ from the reference's: the
+/// request's and the answer's transit plus an answer delay inside the manual's bounds
+/// (about 50 ms at 6.144 ms a scan).
+const TIMER_SLACK_SCANS: i64 = 8;
+
+/// What power-up clears and what the parameter save keeps of the user bits (manual 3.8.1
+/// Pb91, Pb94, b90.8..b90.15): the volatile bits read 0 after power-up, a saved user flag
+/// is still set.
+fn power_up(g: &mut Gen) {
+    let volatile: [(&[&str], &str); 2] = [
+        (&names::VOLATILE_FLAGS, "HPD-BIT-91-POWER-ON"),
+        (&names::POWER_UP_CLEARED, "HPD-BIT-94-POWER-ON"),
+    ];
+    for (bits, requirement) in volatile {
+        let refs: Vec<_> = bits.iter().filter_map(|n| g.bit_ref(n)).collect();
+        let Some(first) = refs.first() else { continue };
+        let slot = first.slot;
+        let param = first.param.id.clone();
+        let mut mask = 0u32;
+        for r in &refs {
+            mask |= bit_value(r.slot, r.at);
+        }
+        let mut cb = CaseB::new(
+            format!("hpd/cmd/power-up/{param}"),
+            format!(
+                "{} set over the line read 0 after the drive is switched off and on",
+                bits.join(", ")
+            ),
+            &[requirement],
+        );
+        for r in &refs {
+            g.bit(&mut cb, Role::Setup, r, true);
+        }
+        cb.power_cycle();
+        g.read(
+            &mut cb,
+            Role::Check,
+            slot,
+            Compare::Mask(mask),
+            &format!("{param} (bits cleared at power-up)"),
+        );
+        g.push(cb);
+    }
+
+    let save = g.protocol.serial_setup.save_bit.clone();
+    let (Some(save_ref), Some(flag)) = (g.bit_ref(&save), g.bit_ref(names::SAVED_FLAG)) else {
+        return;
+    };
+    let mut cb = CaseB::new(
+        format!("hpd/cmd/{save}/user-flags"),
+        format!(
+            "{save} stores the user flag {} = 1: after power-up it is 1 again although it was cleared",
+            names::SAVED_FLAG
+        ),
+        &["HPD-BIT-90-USER", "HPD-CMD-012", "HPD-PAR-018"],
+    );
+    g.bit(&mut cb, Role::Setup, &flag, true);
+    g.bit(&mut cb, Role::Check, &save_ref, true);
+    g.bit(&mut cb, Role::Check, &flag, false);
+    cb.power_cycle();
+    let user = bit_value(flag.slot, flag.at);
+    g.read(
+        &mut cb,
+        Role::Check,
+        flag.slot,
+        Compare::Mask(user),
+        "Pb90 (the saved user flag)",
+    );
+    g.restore(&mut cb, flag.slot, "Pb90");
+    g.bit(&mut cb, Role::Cleanup, &save_ref, true);
+    g.push(cb);
 }

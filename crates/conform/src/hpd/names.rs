@@ -28,6 +28,12 @@ pub const READ_ONLY: &str = "Pr25";
 pub const WITH_DEFAULT: &str = "Pr2";
 /// A user flag bit (manual 3.8.1 b90.8).
 pub const USER_FLAG: &str = "b90.8";
+/// Another saved user flag, kept by the parameter save (manual 3.8.1 b90.8..b90.15).
+pub const SAVED_FLAG: &str = "b90.9";
+/// Volatile user flags, 0 at power-up (manual 3.8.1 b91.8..b91.15).
+pub const VOLATILE_FLAGS: [&str; 2] = ["b91.9", "b91.12"];
+/// The double-word flag and two FIN disables, 0 at power-up (manual 3.8.1 b94.0, b94.5..b94.7).
+pub const POWER_UP_CLEARED: [&str; 3] = ["b94.0", "b94.5", "b94.7"];
 
 /// Bit-rule trigger of command bits (bits.toml).
 pub const TRIGGER_COMMAND: &str = "command-executed";

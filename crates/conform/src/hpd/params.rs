@@ -57,7 +57,12 @@ fn param_cases(g: &mut Gen, p: &Parameter) {
             );
             g.read_open(&mut cb, slot, bounds, &requirement, &p.id);
         }
-        None => g.read(&mut cb, Role::Check, slot, cmp, &p.id),
+        None => {
+            // The start state is the delivery state (commissioned for the serial line), so
+            // the read compares the factory value the manual states.
+            cb.reqs(g.linked(p, |t| t.contains("factory value")));
+            g.read(&mut cb, Role::Check, slot, cmp, &p.id);
+        }
     }
     g.push(cb);
 

@@ -822,6 +822,21 @@ impl HpdSession<'_, '_> {
                 elapsed_us: 0,
             };
         }
+        let applies_inputs = case
+            .steps
+            .iter()
+            .any(|s| matches!(s.action, Action::Inputs { .. }));
+        if applies_inputs && !caps.inputs {
+            return CaseRun {
+                findings: Vec::new(),
+                checked: Vec::new(),
+                outcome: Outcome::Skip {
+                    reason: "needs the device's digital inputs driven, which this transport cannot do (only sim can)".to_owned(),
+                },
+                evidence: Vec::new(),
+                elapsed_us: 0,
+            };
+        }
         let start = self.link.now();
         if caps.reset && from_start {
             match self.link.reset() {

@@ -41,6 +41,12 @@ pub enum Kind {
     /// A write of Pb99 (the PLC run bit, written by every set-up that stops the PLC) is
     /// taken but not acknowledged.
     SilentSetupWrite,
+    /// Timer 2 (Pr93) counts down two per PLC scan.
+    FastTimer,
+    /// The digital inputs are never read: b90.0..b90.7 keep their start state.
+    DeafInputs,
+    /// The volatile user flags of Pb91 survive power-up.
+    KeepsVolatileFlags,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -382,9 +388,19 @@ impl SimDevice for Mutant {
         self.rx(now, bytes);
     }
     fn advance(&mut self, now: Micros) {
+        let timer = Target::parse(spec().family(FamilyId::Hpd), "Pr93").unwrap();
+        let before = self.inner.value(&timer).unwrap_or(0);
         self.inner.advance(now);
         if self.kind == Kind::FinAnywhere {
             self.late_fins(now);
+        }
+        if self.kind == Kind::FastTimer {
+            let after = self.inner.value(&timer).unwrap_or(0);
+            if after < before && after > 0 {
+                let _ = self
+                    .inner
+                    .set_value(now, &timer, (after - (before - after)).max(0));
+            }
         }
     }
     fn poll_output(&mut self) -> Option<Output> {
@@ -407,13 +423,20 @@ impl SimDevice for Mutant {
     }
     fn power_cycle(&mut self, now: Micros) {
         self.held.clear();
+        let flags = Target::parse(spec().family(FamilyId::Hpd), "Pb91").unwrap();
+        let kept = self.inner.value(&flags).unwrap_or(0);
         self.inner.power_cycle(now);
+        if self.kind == Kind::KeepsVolatileFlags {
+            let _ = self.inner.set_value(now, &flags, kept & 0xFF00);
+        }
     }
     fn clone_box(&self) -> Box<dyn SimDevice> {
         Box::new(self.clone())
     }
     fn set_inputs(&mut self, now: Micros, inputs: u16) -> bool {
-        self.inner.set_inputs(now, inputs);
+        if self.kind != Kind::DeafInputs {
+            self.inner.set_inputs(now, inputs);
+        }
         true
     }
 }
@@ -562,6 +585,27 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::SilentSetupWrite,
             breaks: v(&["HPD-FRAME-011"]),
             must_fail: &["hpd/param/Pr33/min", "hpd/bit/b90.8/set"],
+        },
+        Case {
+            name: "timer 2 counts two per scan",
+            kind: Kind::FastTimer,
+            breaks: v(&["HPD-TIMER-002", "HPD-TIMER-004"]),
+            must_fail: &["hpd/plc/timers"],
+        },
+        Case {
+            name: "digital inputs never read",
+            kind: Kind::DeafInputs,
+            breaks: v(&["HPD-BIT-90-INPUTS"]),
+            must_fail: &[
+                "hpd/plc/vector/plc-ld-out",
+                "hpd/plc/vector/plc-default-limits-enabled-closed",
+            ],
+        },
+        Case {
+            name: "volatile user flags survive power-up",
+            kind: Kind::KeepsVolatileFlags,
+            breaks: v(&["HPD-BIT-91-POWER-ON"]),
+            must_fail: &["hpd/cmd/power-up/Pb91"],
         },
         Case {
             name: "command bits stay set",
