@@ -1,5 +1,6 @@
 //! The PSD4xx step language: [`Step`], one master action, environment event or wait of a
-//! timed sequence (suite cases, scenario files, sim-run scripts, fuzz replay files), and the
+//! timed sequence (suite cases, scenario files, fuzz replay files, and the `sim-run` script,
+//! whose commands are a text form of it: [`crate::script`]), and the
 //! `sequence` vectors (`spec/psd4xx/vectors`) with their [`VectorStep`]: what the environment
 //! does, what the master sends in the process data, what the step waits for and what the
 //! drive must show then (manual 3.6, 3.7, 3.8, chapter 4; `spec/SCHEMA.md` "Steps and
@@ -8,6 +9,7 @@
 //! Every record is `deny_unknown_fields`: a misspelt key is an error naming the key, and
 //! [`check_steps`] reports it as a `spec check` problem.
 
+use crate::model::LinkEvent;
 use crate::{CommandCode, PkwRequest};
 use drivespec_positioner::step::{check_sequences, Sequence, State, Wait};
 use drivespec_spec::hex::{parse_hex, to_hex};
@@ -77,6 +79,21 @@ pub enum Step {
         /// How long (µs).
         us: u64,
     },
+    /// A direct parameter write: the reference model's own access, no PKW or record traffic
+    /// (3.3); a device under test has no such access.
+    Par {
+        /// Parameter number.
+        pnu: u16,
+        /// Value.
+        value: i64,
+    },
+    /// A change of the connection to the IO controller (3.9, 4.9).
+    Link {
+        /// The change.
+        event: LinkEvent,
+    },
+    /// Control voltage off and on again (2.2).
+    PowerCycle,
 }
 
 impl Step {
@@ -92,6 +109,9 @@ impl Step {
             Step::Until { .. } => "until",
             Step::Env { .. } => "env",
             Step::Advance { .. } => "advance",
+            Step::Par { .. } => "par",
+            Step::Link { .. } => "link",
+            Step::PowerCycle => "power-cycle",
         }
     }
 }

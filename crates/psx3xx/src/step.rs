@@ -1,4 +1,7 @@
-//! The PSx3xx step language of the `sequence` vectors (`spec/psx3xx/vectors`): what the
+//! The PSx3xx step language: [`Step`], one master action or environment change of a timed
+//! sequence (suite cases, scenario files, fuzz replay files, and the `sim-run` script, whose
+//! commands are a text form of it: [`crate::script`]), and the step language of the
+//! `sequence` vectors (`spec/psx3xx/vectors`): what the
 //! master sends (process data, ISDU), what the environment or the operator does (events, jog
 //! keys, the IO-Link connection) and what the drive must show after each step (manual 3.3,
 //! 4.4–4.6, 5.9–5.14; `spec/SCHEMA.md` "Steps and scenarios").
@@ -6,6 +9,7 @@
 //! Every record is `deny_unknown_fields`: a misspelt key is an error naming the key, and
 //! [`check_steps`] reports it as a `spec check` problem.
 
+use crate::model::LinkEvent;
 use drivespec_positioner::step::{check_sequences, Sequence, State};
 use drivespec_spec::{Problem, Spec};
 use serde::{Deserialize, Serialize};
@@ -90,6 +94,46 @@ pub enum Step {
         /// The change.
         env: String,
     },
+    /// New values in the active format's process output (absent: unchanged), then one cycle
+    /// (3.3.1): the control word (ISDU 110), the target (ISDU 112), the target speed in rpm
+    /// (format 2).
+    Process {
+        /// Control word.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        control: Option<u16>,
+        /// Target position.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        target: Option<i32>,
+        /// Target speed, rpm (format 2).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        speed: Option<i16>,
+    },
+    /// The format-0 output from now on: control code and time stamp (3.3.1, 4.4).
+    Stamp {
+        /// Control code (bits 0–1).
+        code: u8,
+        /// Time stamp (bits 2–15).
+        stamp: u16,
+    },
+    /// The jog key inputs (5.10).
+    Keys {
+        /// Forward key (pin 2) pressed.
+        #[serde(default)]
+        forward: bool,
+        /// Reverse key (pin 3) pressed.
+        #[serde(default)]
+        reverse: bool,
+    },
+    /// A change of the IO-Link communication (5.9).
+    Link {
+        /// The change.
+        event: LinkEvent,
+    },
+    /// Supply off and on again.
+    PowerCycle,
+    /// What the three LEDs show, read off the reference model (2.6, 3.3.1); a device under
+    /// test shows them to the eye only.
+    Leds,
 }
 
 fn is_zero_i32(v: &i32) -> bool {
@@ -131,6 +175,12 @@ impl Step {
             Step::IsduPoll { .. } => "isdu-poll",
             Step::IsduWrite { .. } => "isdu-write",
             Step::Env { .. } => "env",
+            Step::Process { .. } => "process",
+            Step::Stamp { .. } => "stamp",
+            Step::Keys { .. } => "keys",
+            Step::Link { .. } => "link",
+            Step::PowerCycle => "power-cycle",
+            Step::Leds => "leds",
         }
     }
 }
