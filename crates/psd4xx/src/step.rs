@@ -11,10 +11,9 @@
 
 use crate::model::LinkEvent;
 use crate::{CommandCode, PkwRequest};
-use drivespec_positioner::step::{check_sequences, Sequence, State, Wait};
-use drivespec_spec::hex::{parse_hex, to_hex};
+use drivespec_positioner::step::{check_sequences, SequenceInput, SequenceVector, State, Wait};
 use drivespec_spec::{FamilyId, Problem, Spec};
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Deserialize, Serialize};
 
 /// One step of a PSD4xx sequence, keyed by `do` (`spec/SCHEMA.md` "Steps and scenarios").
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -53,7 +52,7 @@ pub enum Step {
         /// Record index (= parameter number).
         index: u16,
         /// The data, as hex (`01 00 07`).
-        #[serde(serialize_with = "hex_out", deserialize_with = "hex_in")]
+        #[serde(with = "drivespec_positioner::step::hex_text")]
         hex: Vec<u8>,
     },
     /// Cycles with the outputs unchanged.
@@ -159,54 +158,31 @@ impl From<PkwBlock> for PkwRequest {
     }
 }
 
-fn hex_out<S: Serializer>(bytes: &[u8], s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_str(&to_hex(bytes))
-}
-
-fn hex_in<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
-    let text = String::deserialize(d)?;
-    parse_hex(&text).map_err(serde::de::Error::custom)
-}
-
 /// The `input` of a sequence vector.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Input {
     /// Parameter number to value, set before the first step (3: where the shaft stands,
     /// 1 and 2: a live status word and speed to reach, 13: the model string).
-    #[serde(default)]
     pub state: State,
     /// The steps, in order.
-    #[serde(default)]
     pub steps: Vec<VectorStep>,
 }
 
 /// The `expect` of a sequence vector: what holds after the last step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Final {
     /// The actual position at the end, within the positioning window (par. 44).
-    #[serde(default)]
     pub actual: Option<i64>,
 }
 
-/// A typed PSD4xx `sequence` vector.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PsdSequence {
-    /// Start state and steps.
-    pub input: Input,
-    /// What holds at the end.
-    pub expect: Final,
+impl SequenceInput for Input {
+    type Step = VectorStep;
 }
 
-impl Sequence for PsdSequence {
-    type Input = Input;
-    type Expect = Final;
-    type Step = VectorStep;
-    fn new(input: Input, expect: Final) -> PsdSequence {
-        PsdSequence { input, expect }
-    }
-}
+/// A typed PSD4xx `sequence` vector.
+pub type PsdSequence = SequenceVector<Input, Final>;
 
 /// One step of a `sequence` vector: an event, then the process output (control word and
 /// target), then the wait, then the expectations.
