@@ -15,6 +15,7 @@
 pub mod capture;
 pub mod check;
 pub mod hpd;
+mod ops;
 pub mod pd;
 pub mod psd4xx;
 pub mod psx3xx;

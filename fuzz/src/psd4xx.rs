@@ -1,7 +1,7 @@
 //! Fuzz harness of the PSD4xx reference drive model (manual 3.2–3.9, chapter 4): arbitrary
 //! output images, records, parameter writes, environment and connection events and time steps.
 
-use drivespec_positioner::EnvChange;
+use crate::ops::{env_change, word};
 use drivespec_psd4xx::model::{Drive, DriveConfig, LinkEvent, RecordRequest};
 use drivespec_psd4xx::{Input, Output, Rules};
 use drivespec_spec::Spec;
@@ -16,41 +16,6 @@ fn spec() -> &'static Spec {
 fn template() -> &'static Drive {
     static DRIVE: OnceLock<Drive> = OnceLock::new();
     DRIVE.get_or_init(|| Drive::new(spec(), DriveConfig::new("PSD401-5V")).expect("model drive"))
-}
-
-fn word(b: &[u8], i: usize) -> u16 {
-    u16::from_le_bytes([
-        b.get(i).copied().unwrap_or(0),
-        b.get(i + 1).copied().unwrap_or(0),
-    ])
-}
-
-fn env_change(arg: &[u8]) -> EnvChange {
-    let k = arg.first().copied().unwrap_or(0);
-    let w = word(arg, 1);
-    let s = w as i16;
-    match k % 12 {
-        0 => EnvChange::MotorVoltage { dv: w % 400 },
-        1 => EnvChange::ControlVoltage { dv: w % 2 * 240 },
-        2 => EnvChange::Temperature { celsius: s % 120 },
-        3 => EnvChange::LoadTorque { cnm: w % 200 },
-        4 => EnvChange::Jam { on: w & 1 == 1 },
-        5 => EnvChange::Block {
-            at: i64::from(s) * 16,
-        },
-        6 => EnvChange::ClearBlocks,
-        7 => EnvChange::Displace {
-            by: i64::from(s) * 4,
-        },
-        8 => EnvChange::BackDrive {
-            rpm: i32::from(s % 50),
-        },
-        9 => EnvChange::MissSteps {
-            by: i64::from(w % 64),
-        },
-        10 => EnvChange::PositionFault,
-        _ => EnvChange::MotorVoltage { dv: 240 },
-    }
 }
 
 /// Checks what must hold in every state (manual 3.6) and that the image codes cleanly (3.5.2).

@@ -2,7 +2,7 @@
 //! images in the active format, ISDU requests, IO-Link events, jog keys, environment changes,
 //! power cycles and time steps.
 
-use drivespec_positioner::EnvChange;
+use crate::ops::{env_change, word};
 use drivespec_psx3xx::isdu::{Request, Value};
 use drivespec_psx3xx::model::LedLight;
 use drivespec_psx3xx::model::{Drive, DriveConfig, JogKeys, LinkEvent};
@@ -59,41 +59,6 @@ fn template(format: u8, brake: bool, other: bool) -> &'static Drive<'static> {
     });
     let set = usize::from(brake) + if other { 2 } else { 0 };
     &drives[usize::from(format % 3) + 3 * set]
-}
-
-fn word(b: &[u8], i: usize) -> u16 {
-    u16::from_le_bytes([
-        b.get(i).copied().unwrap_or(0),
-        b.get(i + 1).copied().unwrap_or(0),
-    ])
-}
-
-fn env_change(arg: &[u8]) -> EnvChange {
-    let k = arg.first().copied().unwrap_or(0);
-    let w = word(arg, 1);
-    let s = w as i16;
-    match k % 12 {
-        0 => EnvChange::MotorVoltage { dv: w % 400 },
-        1 => EnvChange::ControlVoltage { dv: w % 2 * 240 },
-        2 => EnvChange::Temperature { celsius: s % 120 },
-        3 => EnvChange::LoadTorque { cnm: w % 200 },
-        4 => EnvChange::Jam { on: w & 1 == 1 },
-        5 => EnvChange::Block {
-            at: i64::from(s) * 16,
-        },
-        6 => EnvChange::ClearBlocks,
-        7 => EnvChange::Displace {
-            by: i64::from(s) * 4,
-        },
-        8 => EnvChange::BackDrive {
-            rpm: i32::from(s % 50),
-        },
-        9 => EnvChange::MissSteps {
-            by: i64::from(w % 64),
-        },
-        10 => EnvChange::PositionFault,
-        _ => EnvChange::MotorVoltage { dv: 240 },
-    }
 }
 
 /// What must hold in every state (manual 3.3.2, 3.4).

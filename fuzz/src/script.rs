@@ -9,11 +9,11 @@ use drivespec_psd4xx::model::DriveConfig;
 /// thousands of inputs a second.
 const PLAY_US: u64 = 200_000;
 
-/// Parsed steps come in file order with times that never go back.
-fn steps_in_order<C>(script: &Script<C>, text: &str) {
+/// Parsed lines come in file order with times that never go back.
+fn lines_in_order<C>(script: &Script<C>, text: &str) {
     let lines = text.lines().count();
     let mut last = (0, 0);
-    for step in &script.steps {
+    for step in &script.lines {
         assert!(
             step.line >= 1 && step.line <= lines,
             "line {} of {lines}",
@@ -37,7 +37,7 @@ pub fn psd4xx(data: &[u8]) {
     let Ok(script) = drivespec_psd4xx::script::parse(psd(), &text) else {
         return;
     };
-    steps_in_order(&script, &text);
+    lines_in_order(&script, &text);
     if script.last() <= PLAY_US {
         let opts = RunOptions {
             every_ms: 0,
@@ -47,7 +47,7 @@ pub fn psd4xx(data: &[u8]) {
         let trace =
             drivespec_psd4xx::script::run(spec(), DriveConfig::new("PSD401-5V"), &script, &opts);
         if let Ok(trace) = trace {
-            assert!(trace.passed + trace.failed <= script.steps.len());
+            assert!(trace.passed + trace.failed <= script.lines.len());
         }
     }
 }
@@ -56,6 +56,6 @@ pub fn psd4xx(data: &[u8]) {
 pub fn psx3xx(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     if let Ok(script) = drivespec_psx3xx::script::parse(psx(), &text) {
-        steps_in_order(&script, &text);
+        lines_in_order(&script, &text);
     }
 }

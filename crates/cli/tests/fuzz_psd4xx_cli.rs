@@ -9,7 +9,7 @@
     clippy::panic
 )]
 
-use drivespec_testkit::{run, temp_dir};
+use drivespec_testkit::{fuzz_finds_nothing, run, temp_dir};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -17,36 +17,14 @@ const BIN: &str = env!("CARGO_BIN_EXE_drivespec");
 
 #[test]
 fn against_the_reference_nothing_is_found() {
-    let out = temp_dir("fuzz-psd-cli", "sim");
-    let dir = out.display().to_string();
-    let (code, stdout, stderr) = run(
+    fuzz_finds_nothing(
         BIN,
-        &[
-            "fuzz",
-            "psd4xx",
-            "--model",
-            "PSD426",
-            "--iterations",
-            "40",
-            "--seed",
-            "3",
-            "--out",
-            &dir,
-        ],
+        "psd4xx",
+        &["--model", "PSD426"],
+        "PSD426",
+        40,
+        "pkw-handshake-violation",
     );
-    assert_eq!(code, 0, "{stdout}{stderr}");
-    assert!(
-        stdout.contains("40 sequence(s)") && stdout.contains("0 finding(s)"),
-        "{stdout}"
-    );
-    assert!(stdout.contains("sim:PSD426"), "{stdout}");
-    assert!(stderr.contains("fuzz psd4xx: 40/40 sequences"), "{stderr}");
-    for f in ["fuzz.json", "fuzz.junit.xml", "fuzz.html"] {
-        assert!(out.join(f).is_file(), "{f}");
-    }
-    let json = std::fs::read_to_string(out.join("fuzz.json")).unwrap();
-    assert!(json.contains("\"pkw-handshake-violation\""), "{json}");
-    std::fs::remove_dir_all(&out).unwrap();
 }
 
 #[test]

@@ -11,7 +11,7 @@
     clippy::panic
 )]
 
-use drivespec_testkit::{run, temp_dir};
+use drivespec_testkit::{fuzz_finds_nothing, run, temp_dir};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -24,34 +24,7 @@ fn exec_sim() -> String {
 
 #[test]
 fn against_the_reference_nothing_is_found() {
-    let out = temp_dir("fuzz-psx-cli", "sim");
-    let dir = out.display().to_string();
-    let (code, stdout, stderr) = run(
-        BIN,
-        &[
-            "fuzz",
-            "psx3xx",
-            "--iterations",
-            "30",
-            "--seed",
-            "3",
-            "--out",
-            &dir,
-        ],
-    );
-    assert_eq!(code, 0, "{stdout}{stderr}");
-    assert!(
-        stdout.contains("30 sequence(s)") && stdout.contains("0 finding(s)"),
-        "{stdout}"
-    );
-    assert!(stdout.contains("sim:PSE312-8"), "{stdout}");
-    assert!(stderr.contains("fuzz psx3xx: 30/30 sequences"), "{stderr}");
-    for f in ["fuzz.json", "fuzz.junit.xml", "fuzz.html"] {
-        assert!(out.join(f).is_file(), "{f}");
-    }
-    let json = std::fs::read_to_string(out.join("fuzz.json")).unwrap();
-    assert!(json.contains("\"isdu-write\""), "{json}");
-    std::fs::remove_dir_all(&out).unwrap();
+    fuzz_finds_nothing(BIN, "psx3xx", &[], "PSE312-8", 30, "isdu-write");
 }
 
 #[test]

@@ -9,7 +9,7 @@ use crate::case::{
     Role,
 };
 use crate::cyclic::device::Device;
-use crate::cyclic::{Env, LinkPeer, LocalPeer, Peer, PeerError, Reply, Request, Server};
+use crate::cyclic::{Env, LinkPeer, LocalPeer, Peer, PeerError, Reply, Request, Server, WireError};
 use crate::dut::Dut;
 use crate::link::{ExecLink, SerialLink, TcpLink};
 use crate::suite::{Session, SetupError};
@@ -139,6 +139,9 @@ pub enum Op<O> {
     Advance(u64),
     /// A request between two cycles, judged by its reply.
     Exchange(Request),
+    /// A step no device exchange plays (a direct write into the reference model, an
+    /// environment text that is no injection): the case ends here with this reason.
+    Refuse(String),
     /// A read repeated once a cycle (at that cycle's time) while the device's reply does not
     /// yet conform to the reference's, at most `max` cycles; judged by the last reply. A state
     /// the manual lets last a bounded time (PSx3xx 3.1: ISDU 193 reads ≠ 0 while a save runs,
@@ -149,6 +152,26 @@ pub enum Op<O> {
         /// Most cycles.
         max: u32,
     },
+}
+
+/// The `ENV` request at `t` for an environment change in its text form (`jam 1`).
+pub(crate) fn env_request(t: u64, env: &str) -> Result<Request, WireError> {
+    match Request::parse(&format!("ENV {t} {env}"))? {
+        r @ Request::Env { .. } => Ok(r),
+        _ => Err(WireError {
+            line: env.to_owned(),
+            what: String::from("not an environment change"),
+        }),
+    }
+}
+
+/// What an environment step in its text form does: its `ENV` request at `t`, or a refusal
+/// naming the text.
+pub(crate) fn env_op<O>(t: u64, env: &str) -> Op<O> {
+    env_request(t, env).map_or_else(
+        |e| Op::Refuse(format!("environment step {env:?}: {e}")),
+        Op::Exchange,
+    )
 }
 
 /// `req` with its time set to `t` (requests without a time unchanged).
@@ -807,6 +830,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     }
                     continue;
                 }
+                Op::Refuse(reason) => return Err(reason),
                 Op::Poll { req, max } => {
                     for _ in 0..max {
                         if self.conforms(run, &at_time(&req, run.t)) {

@@ -440,6 +440,45 @@ pub(crate) fn below(rng: &mut Rng, n: usize) -> usize {
     usize::try_from(rng.range(0, hi.max(0))).unwrap_or(0)
 }
 
+/// Declares a generator's `Template` enum and its `TEMPLATES` table from one list of
+/// `Name = weight` (the weight: how often the template is drawn, [`weighted`]).
+macro_rules! templates {
+    ($(#[$meta:meta])* $($name:ident = $weight:expr),+ $(,)?) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        enum Template {
+            $($name),+
+        }
+
+        /// Every template with its weight.
+        const TEMPLATES: &[(Template, u32)] = &[$((Template::$name, $weight)),+];
+    };
+}
+pub(crate) use templates;
+
+/// One of the items of `table` that `usable` accepts, drawn by weight with one draw of `rng`;
+/// `fallback` when their weights add up to nothing.
+pub(crate) fn weighted<T: Copy>(
+    rng: &mut Rng,
+    table: &[(T, u32)],
+    usable: impl Fn(T) -> bool,
+    fallback: T,
+) -> T {
+    let total: u32 = table
+        .iter()
+        .filter(|(t, _)| usable(*t))
+        .map(|(_, w)| *w)
+        .sum();
+    let mut x = u32::try_from(rng.range(0, i64::from(total.max(1)) - 1)).unwrap_or(0);
+    for (t, w) in table.iter().filter(|(t, _)| usable(*t)) {
+        if x < *w {
+            return *t;
+        }
+        x -= w;
+    }
+    fallback
+}
+
 /// One of `items`, None when there are none.
 pub(crate) fn pick<'x, T>(rng: &mut Rng, items: &'x [T]) -> Option<&'x T> {
     if items.is_empty() {

@@ -13,12 +13,12 @@
 mod support;
 
 use drivespec_conform::cyclic::{LocalPeer, Server};
-use drivespec_conform::suite::Settings;
-use drivespec_conform::Progress;
-use drivespec_fuzz::{self as fuzz, Action, Device, FindingClass, Options, Replay};
+use drivespec_fuzz::{self as fuzz, Action, Device, Options, Replay};
 use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_spec::FamilyId;
-use std::time::Instant;
+use support::cyclic::{
+    a_finding_replays, every_mutant_is_found, mutant_options, the_reference_gives_nothing,
+};
 use support::mutants::spec;
 use support::psx3xx_mutants::{mutants, Kind, Mutant};
 
@@ -26,19 +26,7 @@ use support::psx3xx_mutants::{mutants, Kind, Mutant};
 const BOUND: u64 = 150;
 
 fn options() -> Options {
-    Options {
-        family: FamilyId::Psx3xx,
-        iterations: Some(BOUND),
-        minimize_runs: 100,
-        max_findings: 2,
-        no_reports: true,
-        progress: Progress::Quiet,
-        settings: Settings {
-            seed: 1,
-            ..Settings::default()
-        },
-        ..Options::default()
-    }
+    mutant_options(FamilyId::Psx3xx, BOUND, 2)
 }
 
 fn mutant(kind: Kind, name: &str) -> Device {
@@ -77,128 +65,17 @@ const BEYOND_REACH: &[&str] = &["status bits 14 and 15 (range limits) swapped"];
 
 #[test]
 fn every_psx3xx_mutant_is_found_with_a_short_replay() {
-    let opts = options();
-    let all: Vec<_> = mutants()
+    let all: Vec<(&str, Kind)> = mutants()
         .into_iter()
         .filter(|m| !BEYOND_REACH.contains(&m.name))
+        .map(|m| (m.name, m.kind))
         .collect();
-    let results: Vec<(String, Kind, fuzz::Summary)> = std::thread::scope(|s| {
-        let handles: Vec<_> = all
-            .chunks(all.len().div_ceil(2))
-            .map(|chunk| {
-                let opts = &opts;
-                s.spawn(move || {
-                    chunk
-                        .iter()
-                        .map(|m| {
-                            let summary = fuzz::run_on_device(
-                                spec(),
-                                opts,
-                                mutant(m.kind, m.name),
-                                &mut std::io::sink(),
-                            )
-                            .unwrap();
-                            (m.name.to_owned(), m.kind, summary)
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect()
-    });
-    let mut problems = Vec::new();
-    for (name, kind, s) in &results {
-        let first = s.stats.findings.iter().map(|f| f.first_sequence).min();
-        let shortest = s
-            .stats
-            .findings
-            .iter()
-            .filter(|f| f.reproduced)
-            .map(|f| f.steps)
-            .min();
-        println!(
-            "{name:<45} found after {:>3} sequence(s); shortest replay {} step(s); {} finding(s): {}",
-            first.map_or("-".to_owned(), |n| n.to_string()),
-            shortest.map_or("-".to_owned(), |n| n.to_string()),
-            s.findings.len(),
-            s.stats
-                .findings
-                .iter()
-                .map(|f| format!("{} ({})", f.signature, f.steps))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-        match shortest {
-            None => problems.push(format!("{name}: not found in {BOUND} sequences")),
-            Some(n) if n > limit(*kind) => problems.push(format!(
-                "{name}: shortest replay {n} steps > {}",
-                limit(*kind)
-            )),
-            Some(_) => {}
-        }
-        if s.exit_code() != 1 {
-            problems.push(format!("{name}: exit code {}", s.exit_code()));
-        }
-        for f in &s.findings {
-            let info = f.replay.finding.as_ref().unwrap();
-            assert_ne!(
-                info.class,
-                FindingClass::Crash,
-                "{name}: nothing fails on sim"
-            );
-            assert!(!info.requirements.is_empty(), "{name}: {}", f.id);
-            // Every finding replays: the same exchanges and the same verdict again.
-            let again =
-                fuzz::replay_on_device(spec(), &opts, &f.replay, mutant(*kind, name)).unwrap();
-            if info.reproduced && !(again.same_as_recorded && again.same_finding) {
-                problems.push(format!("{name}: {} does not replay exactly", f.id));
-            }
-        }
-    }
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    every_mutant_is_found(&options(), &all, 2, BOUND, limit, mutant);
 }
 
 #[test]
 fn a_fixed_seed_run_against_the_reference_finds_nothing() {
-    let mut opts = Options {
-        iterations: Some(400),
-        ..options()
-    };
-    opts.settings.seed = 7;
-    let started = Instant::now();
-    let s = fuzz::run(spec(), &opts, &mut std::io::sink()).unwrap();
-    println!(
-        "{} sequences, {} inputs in {:?}; {} requirement(s) touched, classes: {:?}",
-        s.stats.sequences,
-        s.stats.inputs,
-        started.elapsed(),
-        s.stats.requirements_touched.len(),
-        s.stats.inputs_by_class.keys().collect::<Vec<_>>()
-    );
-    assert_eq!(s.stats.sequences, 400);
-    assert!(s.findings.is_empty(), "{:#?}", s.stats.findings);
-    assert_eq!(s.exit_code(), 0);
-    assert!(
-        s.stats.inputs_by_class.len() >= 18,
-        "{:?}",
-        s.stats.inputs_by_class
-    );
-    assert!(s.stats.requirements_touched.len() >= 50);
-    // The same seed sends the same sequences and gives the same statistics.
-    let short = Options {
-        iterations: Some(60),
-        ..opts
-    };
-    let again = fuzz::run(spec(), &short, &mut std::io::sink()).unwrap();
-    let twice = fuzz::run(spec(), &short, &mut std::io::sink()).unwrap();
-    assert_eq!(again.stats.inputs_by_class, twice.stats.inputs_by_class);
-    assert_eq!(
-        again.stats.answers_by_verdict,
-        twice.stats.answers_by_verdict
-    );
+    the_reference_gives_nothing(&options(), 400, 18, 50, 60);
 }
 
 #[test]
@@ -207,63 +84,16 @@ fn replay_files_replay_byte_for_byte() {
         iterations: Some(60),
         ..options()
     };
-    let dir = std::env::temp_dir().join(format!("drivespec-fuzz-psx-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
     let kind = Kind::RangeIgnored;
-    let s = fuzz::run_on_device(
-        spec(),
-        &Options {
-            out_dir: dir.clone(),
-            no_reports: false,
-            ..opts.clone()
-        },
-        mutant(kind, "range-ignored"),
-        &mut std::io::sink(),
-    )
-    .unwrap();
-    // A finding reproduced from a fresh device replays on a fresh one.
-    let f = s
-        .findings
-        .iter()
-        .find(|f| f.replay.finding.as_ref().is_some_and(|i| i.reproduced))
-        .expect("a reproduced finding");
-    let file = f.file.clone().unwrap();
-    let text = std::fs::read_to_string(&file).unwrap();
-    // The same seed finds the same findings with byte-identical replay files.
-    let again = fuzz::run_on_device(
-        spec(),
-        &opts,
-        mutant(kind, "range-ignored"),
-        &mut std::io::sink(),
-    )
-    .unwrap();
-    assert_eq!(again.findings.len(), s.findings.len());
-    for (a, b) in again.findings.iter().zip(&s.findings) {
-        assert_eq!(a.replay.to_json(), b.replay.to_json());
-    }
-    let r = Replay::load(&file).unwrap();
-    // The file round-trips exactly, and names ISDU steps.
-    assert_eq!(r.to_json(), text);
+    let (r, text, dir) =
+        a_finding_replays(&opts, "psx", || mutant(kind, "range-ignored"), "isdu-write");
+    // The file names ISDU steps.
     assert!(
         r.steps
             .iter()
             .any(|s| matches!(s.action, Action::Psx3xx(PsxStep::IsduWrite { .. }))),
         "{text}"
     );
-    assert!(text.contains("\"do\": \"isdu-write\""), "{text}");
-    // Replayed twice: the same exchanges as recorded, byte for byte, both times.
-    for _ in 0..2 {
-        let again =
-            fuzz::replay_on_device(spec(), &opts, &r, mutant(kind, "range-ignored")).unwrap();
-        assert!(again.same_as_recorded, "{text}\n{:#?}", again.exchanges);
-        assert!(again.same_finding);
-        assert_eq!(again.exit_code(), 1);
-        assert_eq!(again.exchanges, r.exchanges);
-    }
-    // Against the reference it passes.
-    let fixed = fuzz::replay(spec(), &opts, &r).unwrap();
-    assert_eq!(fixed.exit_code(), 0);
-    assert!(!fixed.same_finding);
     // A replay of another family is refused, and so are PSD4xx or HPD steps in a PSx3xx file.
     let psd = Options {
         family: FamilyId::Psd4xx,

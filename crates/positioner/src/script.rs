@@ -2,8 +2,10 @@
 //! expectations that a family's reference model runs on virtual time.
 //!
 //! This module holds what every family shares: the line grammar, the times, the environment
-//! changes of [`mod@crate::env`], the expectations and the resulting [`Trace`]. A family adds its
-//! own commands (process data, parameter channel, link events) through a [`Dialect`].
+//! changes of [`mod@crate::env`], the expectations and the resulting [`Trace`]. A family's own
+//! commands (process data, parameter channel, link events) are a text form of the family's
+//! step type (`Step` in the family crate's `step` module, `spec/SCHEMA.md` "Steps and
+//! scenarios"), read through a [`Dialect`].
 //!
 //! ```text
 //! # a comment; blank lines are skipped
@@ -113,12 +115,12 @@ pub struct ScriptError {
 }
 
 /// A family's commands in a script: parses the words after the time that are not `env`,
-/// `expect` or `end`.
+/// `expect` or `end` into the family's step.
 pub trait Dialect {
-    /// A parsed family command.
-    type Command;
+    /// The family's step.
+    type Step;
     /// Parses one family command: `verb` is the first word, `rest` the text after it.
-    fn command(&self, verb: &str, rest: &str) -> Result<Self::Command, LineError>;
+    fn command(&self, verb: &str, rest: &str) -> Result<Self::Step, LineError>;
     /// The family's verbs, for error messages.
     fn verbs(&self) -> &'static str;
 }
@@ -179,7 +181,7 @@ impl Expect {
     }
 }
 
-/// One script action.
+/// What one script line does.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Action<C> {
     /// An environment change.
@@ -188,13 +190,13 @@ pub enum Action<C> {
     Expect(Expect),
     /// The run ends here.
     End,
-    /// A family command.
-    Device(C),
+    /// A family step.
+    Step(C),
 }
 
 /// One script line.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Step<C> {
+pub struct Line<C> {
     /// Line number, 1-based.
     pub line: usize,
     /// Virtual time, µs.
@@ -205,20 +207,17 @@ pub struct Step<C> {
     pub action: Action<C>,
 }
 
-/// A parsed script: steps in time order.
+/// A parsed script: lines in time order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Script<C> {
-    /// The steps, in file order (times never decrease).
-    pub steps: Vec<Step<C>>,
+    /// The lines, in file order (times never decrease).
+    pub lines: Vec<Line<C>>,
 }
 
 impl<C> Script<C> {
     /// Parses a script with a family's dialect.
-    pub fn parse<D: Dialect<Command = C>>(
-        text: &str,
-        dialect: &D,
-    ) -> Result<Script<C>, ScriptError> {
-        let mut steps = Vec::new();
+    pub fn parse<D: Dialect<Step = C>>(text: &str, dialect: &D) -> Result<Script<C>, ScriptError> {
+        let mut lines = Vec::new();
         let mut previous: Micros = 0;
         for (i, raw) in text.lines().enumerate() {
             let line = i.saturating_add(1);
@@ -239,27 +238,27 @@ impl<C> Script<C> {
             previous = at;
             let command = command.trim();
             let action = parse_action(command, dialect).map_err(fail)?;
-            steps.push(Step {
+            lines.push(Line {
                 line,
                 at,
                 text: command.to_owned(),
                 action,
             });
         }
-        Ok(Script { steps })
+        Ok(Script { lines })
     }
 
-    /// The time of the `end` step, if there is one.
+    /// The time of the `end` line, if there is one.
     pub fn end(&self) -> Option<Micros> {
-        self.steps
+        self.lines
             .iter()
             .find(|s| matches!(s.action, Action::End))
             .map(|s| s.at)
     }
 
-    /// The time of the last step, 0 for an empty script.
+    /// The time of the last line, 0 for an empty script.
     pub fn last(&self) -> Micros {
-        self.steps.last().map_or(0, |s| s.at)
+        self.lines.last().map_or(0, |s| s.at)
     }
 }
 
@@ -306,7 +305,7 @@ fn parse_time(text: &str, previous: Micros) -> Result<Micros, LineError> {
 /// cycles), so a run and its trace stay bounded.
 pub const MAX_SCRIPT_US: Micros = 3_600_000_000;
 
-fn parse_action<D: Dialect>(command: &str, dialect: &D) -> Result<Action<D::Command>, LineError> {
+fn parse_action<D: Dialect>(command: &str, dialect: &D) -> Result<Action<D::Step>, LineError> {
     let (verb, rest) = split_word(command);
     match verb {
         "" => Err(LineError::Empty),
@@ -316,7 +315,7 @@ fn parse_action<D: Dialect>(command: &str, dialect: &D) -> Result<Action<D::Comm
             no_more(rest)?;
             Ok(Action::End)
         }
-        _ => dialect.command(verb, rest).map(Action::Device),
+        _ => dialect.command(verb, rest).map(Action::Step),
     }
 }
 
@@ -714,10 +713,10 @@ impl<E> Recorder<E> {
 }
 
 /// A family's reference model as a script runner sees it: the master's
-/// cyclic output, the family's commands, the environment and what the drive shows.
+/// cyclic output, the family's steps, the environment and what the drive shows.
 pub trait Simulated {
-    /// The family's script commands.
-    type Command;
+    /// The family's step.
+    type Step;
     /// The model's trace events.
     type Event;
     /// Runs the model up to `now`.
@@ -726,8 +725,11 @@ pub trait Simulated {
     fn cycle(&mut self, now: Micros);
     /// An environment change at `now`.
     fn env(&mut self, now: Micros, change: EnvChange);
-    /// A family command at `now`; answers go to `rec`.
-    fn command(&mut self, now: Micros, command: &Self::Command, rec: &mut Recorder<Self::Event>);
+    /// Whether the runner can play `step` at one moment; the `do` name of the step when it
+    /// cannot (a step that waits on the drive or counts bus cycles).
+    fn unplayable(step: &Self::Step) -> Option<&'static str>;
+    /// A family step at `now`, one [`Self::unplayable`] accepts; answers go to `rec`.
+    fn step(&mut self, now: Micros, step: &Self::Step, rec: &mut Recorder<Self::Event>);
     /// Moves the model's pending events and asynchronous answers (e.g. a new PKW response in
     /// the input image) into `rec`, stamped `now` when they carry no time.
     fn drain(&mut self, now: Micros, rec: &mut Recorder<Self::Event>);
@@ -792,17 +794,43 @@ impl Sampler {
     }
 }
 
+/// Why a script cannot be played.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlayError {
+    /// A line holds a family step that acts over bus cycles or waits on the drive, which a
+    /// timed script cannot play.
+    #[error("line {line}: a `{step}` step cannot be played at one moment of a script")]
+    Unplayable {
+        /// Line number, 1-based.
+        line: usize,
+        /// The step's `do` name.
+        step: &'static str,
+    },
+}
+
 /// Plays `script` on `sim`.
 ///
 /// The master's output goes out once per bus cycle from time 0; each line acts at its time,
 /// in file order, before the cycle of that time. Without an `end` line the run goes on after
 /// the last line until the model is idle, at most [`RunOptions::tail_limit_us`]. A zero
-/// `cycle_us` counts as 1 µs.
+/// `cycle_us` counts as 1 µs. A script with a step [`Simulated::unplayable`] names is refused
+/// before anything plays.
 pub fn play<S: Simulated>(
     sim: &mut S,
-    script: &Script<S::Command>,
+    script: &Script<S::Step>,
     opts: &RunOptions,
-) -> Played<S::Event> {
+) -> Result<Played<S::Event>, PlayError> {
+    for l in &script.lines {
+        if let Action::Step(step) = &l.action {
+            if let Some(name) = S::unplayable(step) {
+                return Err(PlayError::Unplayable {
+                    line: l.line,
+                    step: name,
+                });
+            }
+        }
+    }
     let mut rec = Recorder {
         entries: Vec::new(),
     };
@@ -816,7 +844,7 @@ pub fn play<S: Simulated>(
     let cycle = opts.cycle_us.max(1);
     let end = script.end();
     let last = script.last();
-    let mut steps = script.steps.iter().peekable();
+    let mut steps = script.lines.iter().peekable();
     let mut next_cycle: Micros = 0;
     let mut now: Micros = 0;
     loop {
@@ -833,7 +861,7 @@ pub fn play<S: Simulated>(
             );
             match &step.action {
                 Action::Env(c) => sim.env(now, *c),
-                Action::Device(c) => sim.command(now, c, &mut rec),
+                Action::Step(c) => sim.step(now, c, &mut rec),
                 Action::Expect(e) => {
                     let o = sim.observe();
                     let ok = e.holds(&o);
@@ -876,12 +904,12 @@ pub fn play<S: Simulated>(
         smp.sample(sim, now, false, &mut rec);
         next_cycle = next_cycle.saturating_add(cycle);
     }
-    Played {
+    Ok(Played {
         entries: rec.entries,
         seen_status: smp.seen,
         passed,
         failed,
-    }
+    })
 }
 
 /// A unit variant's name in kebab case, from its `Debug` form: `LimitReached` →
@@ -951,7 +979,7 @@ mod tests {
 
     struct NoFamily;
     impl Dialect for NoFamily {
-        type Command = String;
+        type Step = String;
         fn command(&self, verb: &str, rest: &str) -> Result<String, LineError> {
             match verb {
                 "say" => Ok(rest.to_owned()),
@@ -974,15 +1002,15 @@ mod tests {
             &NoFamily,
         )
         .unwrap();
-        assert_eq!(s.steps.len(), 5);
-        assert_eq!(s.steps[0].action, Action::Device("hi".to_owned()));
-        assert_eq!(s.steps[1].at, 1_500_000);
+        assert_eq!(s.lines.len(), 5);
+        assert_eq!(s.lines[0].action, Action::Step("hi".to_owned()));
+        assert_eq!(s.lines[1].at, 1_500_000);
         assert_eq!(
-            s.steps[1].action,
+            s.lines[1].action,
             Action::Env(EnvChange::MotorVoltage { dv: 174 })
         );
         assert_eq!(
-            s.steps[3].action,
+            s.lines[3].action,
             Action::Expect(Expect {
                 probe: Probe::Position,
                 low: -5,

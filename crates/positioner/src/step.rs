@@ -2,9 +2,10 @@
 //! the typed reading of a `sequence` vector, where a misspelt key is an error naming the key
 //! (`spec/SCHEMA.md` "Steps and scenarios").
 //!
-//! A family defines its [`Sequence`] (the vector's `input` with its steps, and the vector's
-//! `expect`); [`check_sequences`] reads every `sequence` vector of a family with it and
-//! reports each one that does not fit as a spec [`Problem`] naming file, record and key.
+//! A family defines the vector's `input` (a [`SequenceInput`] naming its step type) and the
+//! vector's `expect`; its typed vector is a [`SequenceVector`] of the two. [`check_sequences`]
+//! reads every `sequence` vector of a family with it and reports each one that does not fit
+//! as a spec [`Problem`] naming file, record and key.
 
 use drivespec_spec::{Family, Problem, ProblemKind, Vector, VectorKind};
 use serde::de::DeserializeOwned;
@@ -56,6 +57,48 @@ pub trait Sequence: Sized {
     type Step: DeserializeOwned;
     /// Builds the sequence from its typed parts.
     fn new(input: Self::Input, expect: Self::Expect) -> Self;
+}
+
+/// Bytes written as hex text in a step (`7E 21 02`; blanks optional): serde's `with` module
+/// of the record and ISDU writes.
+pub mod hex_text {
+    use drivespec_spec::hex::{parse_hex, to_hex};
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    /// The bytes as hex text.
+    pub fn serialize<S: Serializer>(data: &[u8], s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&to_hex(data))
+    }
+
+    /// The bytes of hex text.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
+        let text = String::deserialize(d)?;
+        parse_hex(&text).map_err(serde::de::Error::custom)
+    }
+}
+
+/// The `input` of a family's `sequence` vector, naming the type of one of its steps.
+pub trait SequenceInput: DeserializeOwned {
+    /// One step of the input, read on its own so that an error names the step.
+    type Step: DeserializeOwned;
+}
+
+/// A family's typed `sequence` vector: its `input` (start state and steps) and its `expect`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SequenceVector<I, E> {
+    /// Start state and steps.
+    pub input: I,
+    /// What holds at the end.
+    pub expect: E,
+}
+
+impl<I: SequenceInput, E: DeserializeOwned> Sequence for SequenceVector<I, E> {
+    type Input = I;
+    type Expect = E;
+    type Step = I::Step;
+    fn new(input: I, expect: E) -> SequenceVector<I, E> {
+        SequenceVector { input, expect }
+    }
 }
 
 /// Why a `sequence` vector does not fit its family's step type.

@@ -1,19 +1,24 @@
-//! `sim-run` for the PSD4xx: the family's script commands and the runner that plays a
-//! script on the reference [`Drive`] on virtual time.
+//! `sim-run` for the PSD4xx: the script's text form of the family [`Step`] and the runner
+//! that plays a script on the reference [`Drive`] on virtual time.
 //!
 //! The line grammar, environment changes and expectations are the shared ones of
-//! [`drivespec_positioner::script`]; the PSD4xx commands are:
+//! [`drivespec_positioner::script`]; the PSD4xx commands and the steps they are:
 //!
 //! ```text
-//! control WORD [target POS]      control word (3.7) and optionally the target (par. 33)
-//! target POS                     target only
-//! pkw REQUEST                    PKW block in the mini-syntax (`read:44`, `write:44=5`, `none`)
-//! record read INDEX              acyclic read record (3.2.2)
-//! record write INDEX BYTE…       acyclic write record, hex bytes, control byte first
-//! par PNU = VALUE                direct parameter write (the oracle's access, no PKW traffic)
-//! link connected|lost|iops-bad|iops-good     connection events (3.9, 4.9)
-//! power-cycle                    control voltage off and on again
+//! control WORD [target POS]      process: control word (3.7), optionally the target (par. 33)
+//! target POS                     process: the target only
+//! pkw REQUEST                    pkw: PKW block in the mini-syntax (`read:44`, `write:44=5`, `none`)
+//! record read INDEX              record-read: acyclic read record (3.2.2)
+//! record write INDEX BYTE…       record-write: hex bytes, control byte first
+//! par PNU = VALUE                par: direct parameter write (the oracle's access, no PKW traffic)
+//! link connected|lost|iops-bad|iops-good     link: connection events (3.9, 4.9)
+//! power-cycle                    power-cycle: control voltage off and on again
 //! ```
+//!
+//! The runner plays every step but those that count bus cycles or wait on the drive (`hold`,
+//! `until`, `advance`) and the cyclic-exchange text form of an environment change (`env` steps;
+//! a script writes `env …` lines): a script holding one is refused with
+//! [`PlayError::Unplayable`].
 //!
 //! The controller sends the output image (PKW block, control word, target) once per bus
 //! cycle, and at once when a command changes it. The PKW block stays until a later `pkw` line
@@ -25,48 +30,20 @@
 use crate::model::{
     Drive, DriveConfig, Event, LinkEvent, ModelError, RecordAnswer, RecordFailure, RecordRequest,
 };
+use crate::step::{PkwBlock, Step};
 use crate::{Output, PkwRequest, PkwResponse, Rules};
-pub use drivespec_positioner::script::RunOptions;
 use drivespec_positioner::script::{
     describe_core, kebab, no_more, parse_in, play, split_word, BitName, Dialect, LineError,
     Observation, Recorder, Script, ScriptError, Simulated, Trace,
 };
+pub use drivespec_positioner::script::{PlayError, RunOptions};
 use drivespec_positioner::{decode_bits, EnvChange, Micros};
 use drivespec_spec::hex::{parse_hex_digits, to_hex};
 use drivespec_spec::{FamilyId, Spec};
 use serde::Serialize;
 use std::fmt;
 
-/// One PSD4xx script command (manual 3.2.2, 3.5.1, 3.7, 3.8, 3.9).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PsdCommand {
-    /// Control word and optionally the target (3.7, par. 33).
-    Control {
-        /// Control word.
-        word: u16,
-        /// New target, or the one sent before.
-        target: Option<i32>,
-    },
-    /// The target only (par. 33).
-    Target(i32),
-    /// The PKW block sent from now on (3.8).
-    Pkw(PkwRequest),
-    /// An acyclic record request (3.2.2).
-    Record(RecordRequest),
-    /// A direct parameter write (3.3).
-    Par {
-        /// Parameter number.
-        pnu: u16,
-        /// Value.
-        value: i64,
-    },
-    /// A connection event (3.9, 4.9).
-    Link(LinkEvent),
-    /// Control voltage off and on again (2.2).
-    PowerCycle,
-}
-
-/// The PSD4xx script commands, parsed against the codec tables.
+/// The PSD4xx script commands, parsed into [`Step`]s against the codec tables.
 #[derive(Debug, Clone, Copy)]
 pub struct PsdDialect<'r> {
     rules: &'r Rules,
@@ -82,9 +59,9 @@ impl<'r> PsdDialect<'r> {
 const VERBS: &str = "control, target, pkw, record, par, link, power-cycle, env, expect, end";
 
 impl Dialect for PsdDialect<'_> {
-    type Command = PsdCommand;
+    type Step = Step;
 
-    fn command(&self, verb: &str, rest: &str) -> Result<PsdCommand, LineError> {
+    fn command(&self, verb: &str, rest: &str) -> Result<Step, LineError> {
         match verb {
             "control" => {
                 let (word, tail) = split_word(rest);
@@ -102,12 +79,18 @@ impl Dialect for PsdDialect<'_> {
                         })
                     }
                 };
-                Ok(PsdCommand::Control { word, target })
+                Ok(Step::Process {
+                    control: Some(word),
+                    target,
+                })
             }
             "target" => {
                 let (pos, tail) = split_word(rest);
                 no_more(tail)?;
-                Ok(PsdCommand::Target(parse_in("target", pos)?))
+                Ok(Step::Process {
+                    control: None,
+                    target: Some(parse_in("target", pos)?),
+                })
             }
             "pkw" => {
                 if rest.is_empty() {
@@ -118,7 +101,9 @@ impl Dialect for PsdDialect<'_> {
                 self.rules
                     .pkw()
                     .request_from_text(rest)
-                    .map(PsdCommand::Pkw)
+                    .map(|p| Step::Pkw {
+                        pkw: PkwBlock::from(p),
+                    })
                     .map_err(|e| LineError::Family {
                         message: format!("PKW request {rest:?}: {e}"),
                     })
@@ -129,9 +114,9 @@ impl Dialect for PsdDialect<'_> {
                 match op {
                     "read" => {
                         no_more(tail)?;
-                        Ok(PsdCommand::Record(RecordRequest::Read {
+                        Ok(Step::RecordRead {
                             index: parse_in("record index", index)?,
-                        }))
+                        })
                     }
                     "write" => {
                         let index = parse_in("record index", index)?;
@@ -149,7 +134,7 @@ impl Dialect for PsdDialect<'_> {
                                 what: "record bytes (hex, control byte first)",
                             });
                         }
-                        Ok(PsdCommand::Record(RecordRequest::Write { index, data }))
+                        Ok(Step::RecordWrite { index, hex: data })
                     }
                     other => Err(LineError::Unknown {
                         what: "record operation",
@@ -162,7 +147,7 @@ impl Dialect for PsdDialect<'_> {
                 let (lhs, rhs) = rest.split_once('=').ok_or(LineError::Missing {
                     what: "`PNU = VALUE`",
                 })?;
-                Ok(PsdCommand::Par {
+                Ok(Step::Par {
                     pnu: parse_in("parameter number", lhs)?,
                     value: parse_in("value", rhs)?,
                 })
@@ -170,7 +155,7 @@ impl Dialect for PsdDialect<'_> {
             "link" => {
                 let (ev, tail) = split_word(rest);
                 no_more(tail)?;
-                let ev = match ev {
+                let event = match ev {
                     "connected" => LinkEvent::Connected,
                     "lost" => LinkEvent::Lost,
                     "iops-bad" => LinkEvent::IopsBad,
@@ -183,11 +168,11 @@ impl Dialect for PsdDialect<'_> {
                         })
                     }
                 };
-                Ok(PsdCommand::Link(ev))
+                Ok(Step::Link { event })
             }
             "power-cycle" => {
                 no_more(rest)?;
-                Ok(PsdCommand::PowerCycle)
+                Ok(Step::PowerCycle)
             }
             other => Err(LineError::Unknown {
                 what: "command",
@@ -235,6 +220,9 @@ pub enum RunError {
     /// The script has an error.
     #[error(transparent)]
     Script(#[from] ScriptError),
+    /// The script holds a step the runner cannot play.
+    #[error(transparent)]
+    Play(#[from] PlayError),
 }
 
 /// The reference drive with the controller's output image, as the script runner drives it.
@@ -316,7 +304,7 @@ impl PsdSim {
 }
 
 impl Simulated for PsdSim {
-    type Command = PsdCommand;
+    type Step = Step;
     type Event = TraceEvent;
 
     fn advance(&mut self, now: Micros) {
@@ -331,27 +319,54 @@ impl Simulated for PsdSim {
         self.drive.handle_env(now, change);
     }
 
-    fn command(&mut self, now: Micros, c: &PsdCommand, rec: &mut Recorder<TraceEvent>) {
-        match c {
-            PsdCommand::Control { word, target } => {
-                self.out.control = *word;
+    fn unplayable(step: &Step) -> Option<&'static str> {
+        match step {
+            Step::Hold { .. } | Step::Until { .. } | Step::Advance { .. } | Step::Env { .. } => {
+                Some(step.name())
+            }
+            _ => None,
+        }
+    }
+
+    fn step(&mut self, now: Micros, step: &Step, rec: &mut Recorder<TraceEvent>) {
+        match step {
+            Step::Process { control, target } => {
+                if let Some(c) = control {
+                    self.out.control = *c;
+                }
                 if let Some(t) = target {
                     self.out.target = *t;
                 }
                 self.send(now);
             }
-            PsdCommand::Target(t) => {
-                self.out.target = *t;
+            Step::Offset { control, offset } => {
+                if let Some(c) = control {
+                    self.out.control = *c;
+                }
+                let t = i64::from(self.drive.input().actual).saturating_add(*offset);
+                self.out.target =
+                    i32::try_from(t).unwrap_or(if t < 0 { i32::MIN } else { i32::MAX });
                 self.send(now);
             }
-            PsdCommand::Pkw(p) => {
-                self.out.pkw = *p;
+            Step::Pkw { pkw } => {
+                self.out.pkw = PkwRequest::from(*pkw);
                 self.send(now);
             }
-            PsdCommand::Record(r) => self.record(now, r.clone(), rec),
-            PsdCommand::Par { pnu, value } => self.par(now, *pnu, *value, rec),
-            PsdCommand::Link(ev) => self.drive.handle_link(now, *ev),
-            PsdCommand::PowerCycle => self.drive.power_cycle(now),
+            Step::RecordRead { index } => {
+                self.record(now, RecordRequest::Read { index: *index }, rec);
+            }
+            Step::RecordWrite { index, hex } => {
+                let req = RecordRequest::Write {
+                    index: *index,
+                    data: hex.clone(),
+                };
+                self.record(now, req, rec);
+            }
+            Step::Par { pnu, value } => self.par(now, *pnu, *value, rec),
+            Step::Link { event } => self.drive.handle_link(now, *event),
+            Step::PowerCycle => self.drive.power_cycle(now),
+            // Refused by `unplayable` before the script plays.
+            Step::Hold { .. } | Step::Until { .. } | Step::Advance { .. } | Step::Env { .. } => {}
         }
     }
 
@@ -409,7 +424,7 @@ pub fn run_text(
 pub fn run(
     spec: &Spec,
     config: DriveConfig,
-    script: &Script<PsdCommand>,
+    script: &Script<Step>,
     opts: &RunOptions,
 ) -> Result<Trace<TraceEvent>, RunError> {
     let family = spec.family(FamilyId::Psd4xx);
@@ -417,7 +432,7 @@ pub fn run(
         .model(&config.model)
         .map_or_else(|| config.model.clone(), |m| m.id.clone());
     let mut sim = PsdSim::new(Drive::new(spec, config)?);
-    let played = play(&mut sim, script, opts);
+    let played = play(&mut sim, script, opts)?;
     let bits = decode_bits(sim.drive.rules().status_bits(), played.seen_status)
         .set
         .into_iter()
@@ -438,6 +453,6 @@ pub fn run(
 }
 
 /// Parses a script with the PSD4xx commands of `rules`.
-pub fn parse(rules: &Rules, text: &str) -> Result<Script<PsdCommand>, ScriptError> {
+pub fn parse(rules: &Rules, text: &str) -> Result<Script<Step>, ScriptError> {
     Script::parse(text, &PsdDialect::new(rules))
 }

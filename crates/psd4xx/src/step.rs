@@ -1,5 +1,6 @@
 //! The PSD4xx step language: [`Step`], one master action, environment event or wait of a
-//! timed sequence (suite cases, scenario files, sim-run scripts, fuzz replay files), and the
+//! timed sequence (suite cases, scenario files, fuzz replay files, and the `sim-run` script,
+//! whose commands are a text form of it: [`crate::script`]), and the
 //! `sequence` vectors (`spec/psd4xx/vectors`) with their [`VectorStep`]: what the environment
 //! does, what the master sends in the process data, what the step waits for and what the
 //! drive must show then (manual 3.6, 3.7, 3.8, chapter 4; `spec/SCHEMA.md` "Steps and
@@ -8,11 +9,11 @@
 //! Every record is `deny_unknown_fields`: a misspelt key is an error naming the key, and
 //! [`check_steps`] reports it as a `spec check` problem.
 
+use crate::model::LinkEvent;
 use crate::{CommandCode, PkwRequest};
-use drivespec_positioner::step::{check_sequences, Sequence, State, Wait};
-use drivespec_spec::hex::{parse_hex, to_hex};
+use drivespec_positioner::step::{check_sequences, SequenceInput, SequenceVector, State, Wait};
 use drivespec_spec::{FamilyId, Problem, Spec};
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Deserialize, Serialize};
 
 /// One step of a PSD4xx sequence, keyed by `do` (`spec/SCHEMA.md` "Steps and scenarios").
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -51,7 +52,7 @@ pub enum Step {
         /// Record index (= parameter number).
         index: u16,
         /// The data, as hex (`01 00 07`).
-        #[serde(serialize_with = "hex_out", deserialize_with = "hex_in")]
+        #[serde(with = "drivespec_positioner::step::hex_text")]
         hex: Vec<u8>,
     },
     /// Cycles with the outputs unchanged.
@@ -77,6 +78,21 @@ pub enum Step {
         /// How long (µs).
         us: u64,
     },
+    /// A direct parameter write: the reference model's own access, no PKW or record traffic
+    /// (3.3); a device under test has no such access.
+    Par {
+        /// Parameter number.
+        pnu: u16,
+        /// Value.
+        value: i64,
+    },
+    /// A change of the connection to the IO controller (3.9, 4.9).
+    Link {
+        /// The change.
+        event: LinkEvent,
+    },
+    /// Control voltage off and on again (2.2).
+    PowerCycle,
 }
 
 impl Step {
@@ -92,6 +108,9 @@ impl Step {
             Step::Until { .. } => "until",
             Step::Env { .. } => "env",
             Step::Advance { .. } => "advance",
+            Step::Par { .. } => "par",
+            Step::Link { .. } => "link",
+            Step::PowerCycle => "power-cycle",
         }
     }
 }
@@ -139,54 +158,31 @@ impl From<PkwBlock> for PkwRequest {
     }
 }
 
-fn hex_out<S: Serializer>(bytes: &[u8], s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_str(&to_hex(bytes))
-}
-
-fn hex_in<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
-    let text = String::deserialize(d)?;
-    parse_hex(&text).map_err(serde::de::Error::custom)
-}
-
 /// The `input` of a sequence vector.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Input {
     /// Parameter number to value, set before the first step (3: where the shaft stands,
     /// 1 and 2: a live status word and speed to reach, 13: the model string).
-    #[serde(default)]
     pub state: State,
     /// The steps, in order.
-    #[serde(default)]
     pub steps: Vec<VectorStep>,
 }
 
 /// The `expect` of a sequence vector: what holds after the last step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Final {
     /// The actual position at the end, within the positioning window (par. 44).
-    #[serde(default)]
     pub actual: Option<i64>,
 }
 
-/// A typed PSD4xx `sequence` vector.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PsdSequence {
-    /// Start state and steps.
-    pub input: Input,
-    /// What holds at the end.
-    pub expect: Final,
+impl SequenceInput for Input {
+    type Step = VectorStep;
 }
 
-impl Sequence for PsdSequence {
-    type Input = Input;
-    type Expect = Final;
-    type Step = VectorStep;
-    fn new(input: Input, expect: Final) -> PsdSequence {
-        PsdSequence { input, expect }
-    }
-}
+/// A typed PSD4xx `sequence` vector.
+pub type PsdSequence = SequenceVector<Input, Final>;
 
 /// One step of a `sequence` vector: an event, then the process output (control word and
 /// target), then the wait, then the expectations.

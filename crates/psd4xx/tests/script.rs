@@ -8,9 +8,10 @@
     clippy::panic
 )]
 
-use drivespec_positioner::script::{LineError, RunOptions, What};
-use drivespec_psd4xx::model::{DriveConfig, LinkEvent, RecordRequest};
-use drivespec_psd4xx::script::{parse, run_text, PsdCommand, RunError};
+use drivespec_positioner::script::{Action, Line, LineError, PlayError, RunOptions, Script, What};
+use drivespec_psd4xx::model::{DriveConfig, LinkEvent};
+use drivespec_psd4xx::script::{parse, run, run_text, RunError};
+use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::Rules;
 use drivespec_spec::Spec;
 
@@ -36,37 +37,92 @@ fn family_commands_parse() {
          7 ms: pkw read:44\n",
     )
     .unwrap();
-    let cmds: Vec<_> = s
-        .steps
+    let cmds: Vec<Step> = s
+        .lines
         .iter()
         .map(|st| match &st.action {
-            drivespec_positioner::script::Action::Device(c) => c.clone(),
+            Action::Step(c) => c.clone(),
             other => panic!("{other:?}"),
         })
         .collect();
     assert_eq!(
         cmds[0],
-        PsdCommand::Control {
-            word: 0x14,
+        Step::Process {
+            control: Some(0x14),
             target: Some(-250)
         }
     );
-    assert_eq!(cmds[1], PsdCommand::Target(7));
+    assert_eq!(
+        cmds[1],
+        Step::Process {
+            control: None,
+            target: Some(7)
+        }
+    );
     assert_eq!(
         cmds[2],
-        PsdCommand::Record(RecordRequest::Write {
+        Step::RecordWrite {
             index: 44,
-            data: vec![1, 0, 5]
-        })
+            hex: vec![1, 0, 5]
+        }
     );
+    assert_eq!(cmds[3], Step::RecordRead { index: 13 });
+    assert_eq!(cmds[4], Step::Par { pnu: 96, value: -1 });
     assert_eq!(
-        cmds[3],
-        PsdCommand::Record(RecordRequest::Read { index: 13 })
+        cmds[5],
+        Step::Link {
+            event: LinkEvent::IopsBad
+        }
     );
-    assert_eq!(cmds[4], PsdCommand::Par { pnu: 96, value: -1 });
-    assert_eq!(cmds[5], PsdCommand::Link(LinkEvent::IopsBad));
-    assert_eq!(cmds[6], PsdCommand::PowerCycle);
-    assert!(matches!(cmds[7], PsdCommand::Pkw(_)));
+    assert_eq!(cmds[6], Step::PowerCycle);
+    assert!(matches!(cmds[7], Step::Pkw { pkw } if pkw.ak == 1 && pkw.pnu == 44));
+}
+
+#[test]
+fn a_step_that_waits_on_the_drive_is_refused_before_the_run() {
+    let spec = spec();
+    let rules = Rules::from_spec(&spec).unwrap();
+    let mut script = parse(
+        &rules,
+        "0 ms: control 0x14 target 800
+",
+    )
+    .unwrap();
+    for (step, name) in [
+        (Step::Hold { cycles: 3 }, "hold"),
+        (
+            Step::Until {
+                running: false,
+                max: 10,
+            },
+            "until",
+        ),
+        (Step::Advance { us: 5 }, "advance"),
+        (
+            Step::Env {
+                env: "jam 1".to_owned(),
+            },
+            "env",
+        ),
+    ] {
+        script.lines.push(Line {
+            line: 2,
+            at: 1_000,
+            text: name.to_owned(),
+            action: Action::Step(step),
+        });
+        let e = run(&spec, DriveConfig::new("PSD426"), &script, &opts()).unwrap_err();
+        assert_eq!(
+            e,
+            RunError::Play(PlayError::Unplayable {
+                line: 2,
+                step: name
+            })
+        );
+        script.lines.pop();
+    }
+    let empty: Script<Step> = Script { lines: Vec::new() };
+    assert!(run(&spec, DriveConfig::new("PSD426"), &empty, &opts()).is_ok());
 }
 
 #[test]

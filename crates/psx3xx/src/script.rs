@@ -1,74 +1,46 @@
-//! `sim-run` for the PSx3xx: the family's script commands and the runner that plays a
-//! script on the reference [`Drive`] on virtual time.
+//! `sim-run` for the PSx3xx: the script's text form of the family [`Step`] and the runner
+//! that plays a script on the reference [`Drive`] on virtual time.
 //!
 //! The line grammar, environment changes and expectations are the shared ones of
-//! [`drivespec_positioner::script`]; the PSx3xx commands are:
+//! [`drivespec_positioner::script`]; the PSx3xx commands and the steps they are:
 //!
 //! ```text
-//! control WORD [target POS] [speed RPM]   formats 1 and 2: control word (ISDU 110), target
-//!                                         (ISDU 112) and, in format 2, the target speed
-//! target POS                              target only
-//! stamp CODE STAMP                        format 0: control code and time stamp (4.4)
-//! isdu read INDEX[.SUB]                   ISDU read (3.1)
-//! isdu write INDEX[.SUB] = VALUE          ISDU write of an integer, encoded per the spec
-//! keys forward|reverse|both|none          jog key inputs (5.10)
-//! link connected|lost                     IO-Link communication (5.9)
-//! power-cycle                             supply off and on again
-//! leds                                    what the three LEDs show (2.6, 3.3.1)
+//! control WORD [target POS] [speed RPM]   process: formats 1 and 2: control word (ISDU 110),
+//!                                         target (ISDU 112) and, in format 2, the target speed
+//! target POS                              process: target only
+//! stamp CODE STAMP                        stamp: format 0: control code and time stamp (4.4)
+//! isdu read INDEX[.SUB]                   isdu-read: ISDU read (3.1)
+//! isdu write INDEX[.SUB] = VALUE          isdu-write: an integer, encoded per the spec
+//! keys forward|reverse|both|none          keys: jog key inputs (5.10)
+//! link connected|lost                     link: IO-Link communication (5.9)
+//! power-cycle                             power-cycle: supply off and on again
+//! leds                                    leds: what the three LEDs show (2.6, 3.3.1)
 //! ```
 //!
 //! The master sends the process output of the active format once per cycle; in format 0 it
-//! sends nothing until a `stamp` line gives a control code. Nothing here panics; the trace
-//! grows with the simulated time divided by the sampling period, plus one entry per change.
+//! sends nothing until a `stamp` line gives a control code. The runner plays every step but
+//! those that count bus cycles or wait on the drive (`hold`, `until`, `isdu-poll`, `advance`),
+//! a process output in a fixed format (`pd-out`) and the cyclic-exchange text form of an
+//! environment change (`env` steps; a script writes `env …` lines): a script holding one is
+//! refused with [`PlayError::Unplayable`]. Nothing here panics; the trace grows with the
+//! simulated time divided by the sampling period, plus one entry per change.
 
 use crate::isdu::{Request, Response, Value};
 use crate::model::{Drive, DriveConfig, Event, JogKeys, LinkEvent, ModelError};
+use crate::step::Step;
 use crate::{Output, Rules, Stamp, TsCode};
-pub use drivespec_positioner::script::RunOptions;
 use drivespec_positioner::script::{
     describe_core, kebab, no_more, parse_in, play, split_word, BitName, Dialect, LineError,
     Observation, Recorder, Script, ScriptError, Simulated, Trace,
 };
+pub use drivespec_positioner::script::{PlayError, RunOptions};
 use drivespec_positioner::{decode_bits, EnvChange, Micros};
 use drivespec_spec::hex::to_hex;
 use drivespec_spec::{FamilyId, Spec};
 use serde::Serialize;
 use std::fmt;
 
-/// One PSx3xx script command (manual 3.1, 3.3.1, 4.4, 5.9, 5.10).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PsxCommand {
-    /// Control word, and optionally target and target speed (formats 1 and 2, 3.3.1).
-    Control {
-        /// Control word (ISDU 110).
-        word: u16,
-        /// New target (ISDU 112), or the one sent before.
-        target: Option<i32>,
-        /// New target speed in rpm (format 2), or the one sent before.
-        speed: Option<i16>,
-    },
-    /// The target only (ISDU 112).
-    Target(i32),
-    /// Format 0: control code and time stamp (3.3.1, 4.4).
-    Stamp {
-        /// Control code (bits 0–1).
-        code: u8,
-        /// Time stamp (bits 2–15).
-        stamp: u16,
-    },
-    /// An ISDU request (3.1).
-    Isdu(Request),
-    /// The jog key inputs (5.10).
-    Keys(JogKeys),
-    /// An IO-Link communication event (5.9).
-    Link(LinkEvent),
-    /// Supply off and on again.
-    PowerCycle,
-    /// Records what the three LEDs show (2.6, 3.3.1).
-    Leds,
-}
-
-/// The PSx3xx script commands, parsed against the codec tables.
+/// The PSx3xx script commands, parsed into [`Step`]s against the codec tables.
 #[derive(Debug, Clone, Copy)]
 pub struct PsxDialect<'a, 's> {
     rules: &'a Rules<'s>,
@@ -87,14 +59,14 @@ impl<'a, 's> PsxDialect<'a, 's> {
         }
     }
 
-    fn isdu(&self, rest: &str) -> Result<PsxCommand, LineError> {
+    fn isdu(&self, rest: &str) -> Result<Step, LineError> {
         let (op, tail) = split_word(rest);
         match op {
             "read" => {
                 let (addr, tail) = split_word(tail);
                 no_more(tail)?;
                 let (index, subindex) = Self::address(addr)?;
-                Ok(PsxCommand::Isdu(Request::Read { index, subindex }))
+                Ok(Step::IsduRead { index, subindex })
             }
             "write" => {
                 let (lhs, rhs) = tail.split_once('=').ok_or(LineError::Missing {
@@ -111,11 +83,11 @@ impl<'a, 's> PsxDialect<'a, 's> {
                     .rules
                     .encode_value(&target, &Value::Int(value))
                     .map_err(|e| family(format!("ISDU {index}.{subindex} = {value}: {e}")))?;
-                Ok(PsxCommand::Isdu(Request::Write {
+                Ok(Step::IsduWrite {
                     index,
                     subindex,
                     data,
-                }))
+                })
             }
             other => Err(LineError::Unknown {
                 what: "ISDU operation",
@@ -145,9 +117,9 @@ fn word_in<'t>(what: &'static str, text: &'t str, allowed: &str) -> Result<&'t s
 }
 
 impl Dialect for PsxDialect<'_, '_> {
-    type Command = PsxCommand;
+    type Step = Step;
 
-    fn command(&self, verb: &str, rest: &str) -> Result<PsxCommand, LineError> {
+    fn command(&self, verb: &str, rest: &str) -> Result<Step, LineError> {
         match verb {
             "control" => {
                 let (word, mut tail) = split_word(rest);
@@ -167,8 +139,8 @@ impl Dialect for PsxDialect<'_, '_> {
                     }
                     tail = t;
                 }
-                Ok(PsxCommand::Control {
-                    word,
+                Ok(Step::Process {
+                    control: Some(word),
                     target,
                     speed,
                 })
@@ -176,39 +148,47 @@ impl Dialect for PsxDialect<'_, '_> {
             "target" => {
                 let (pos, tail) = split_word(rest);
                 no_more(tail)?;
-                Ok(PsxCommand::Target(parse_in("target", pos)?))
+                Ok(Step::Process {
+                    control: None,
+                    target: Some(parse_in("target", pos)?),
+                    speed: None,
+                })
             }
             "stamp" => {
                 let (code, tail) = split_word(rest);
                 let (stamp, tail) = split_word(tail);
                 no_more(tail)?;
-                Ok(PsxCommand::Stamp {
+                Ok(Step::Stamp {
                     code: parse_in("control code", code)?,
                     stamp: parse_in("time stamp", stamp)?,
                 })
             }
             "isdu" => self.isdu(rest),
-            "keys" => Ok(PsxCommand::Keys(
-                match word_in("jog keys", rest, "forward, reverse, both, none")? {
+            "keys" => {
+                let keys = match word_in("jog keys", rest, "forward, reverse, both, none")? {
                     "forward" => JogKeys::FORWARD,
                     "reverse" => JogKeys::REVERSE,
                     "both" => JogKeys::BOTH,
                     _ => JogKeys::NONE,
-                },
-            )),
-            "link" => Ok(PsxCommand::Link(
-                match word_in("link event", rest, "connected, lost")? {
+                };
+                Ok(Step::Keys {
+                    forward: keys.forward,
+                    reverse: keys.reverse,
+                })
+            }
+            "link" => Ok(Step::Link {
+                event: match word_in("link event", rest, "connected, lost")? {
                     "connected" => LinkEvent::Connected,
                     _ => LinkEvent::Lost,
                 },
-            )),
+            }),
             "power-cycle" => {
                 no_more(rest)?;
-                Ok(PsxCommand::PowerCycle)
+                Ok(Step::PowerCycle)
             }
             "leds" => {
                 no_more(rest)?;
-                Ok(PsxCommand::Leds)
+                Ok(Step::Leds)
             }
             other => Err(LineError::Unknown {
                 what: "command",
@@ -270,6 +250,9 @@ pub enum RunError {
     /// The script has an error.
     #[error(transparent)]
     Script(#[from] ScriptError),
+    /// The script holds a step the runner cannot play.
+    #[error(transparent)]
+    Play(#[from] PlayError),
 }
 
 /// The reference drive with the master's process output, as the script runner drives it.
@@ -361,7 +344,7 @@ impl<'s> PsxSim<'s> {
 }
 
 impl<'s> Simulated for PsxSim<'s> {
-    type Command = PsxCommand;
+    type Step = Step;
     type Event = TraceEvent;
 
     fn advance(&mut self, now: Micros) {
@@ -376,14 +359,28 @@ impl<'s> Simulated for PsxSim<'s> {
         self.drive.handle_env(now, change);
     }
 
-    fn command(&mut self, now: Micros, c: &PsxCommand, rec: &mut Recorder<TraceEvent>) {
-        match c {
-            PsxCommand::Control {
-                word,
+    fn unplayable(step: &Step) -> Option<&'static str> {
+        match step {
+            Step::PdOut { .. }
+            | Step::Hold { .. }
+            | Step::Until { .. }
+            | Step::Advance { .. }
+            | Step::IsduPoll { .. }
+            | Step::Env { .. } => Some(step.name()),
+            _ => None,
+        }
+    }
+
+    fn step(&mut self, now: Micros, step: &Step, rec: &mut Recorder<TraceEvent>) {
+        match step {
+            Step::Process {
+                control,
                 target,
                 speed,
             } => {
-                self.control = *word;
+                if let Some(c) = control {
+                    self.control = *c;
+                }
                 if let Some(t) = target {
                     self.target = *t;
                 }
@@ -392,22 +389,48 @@ impl<'s> Simulated for PsxSim<'s> {
                 }
                 self.send(now, Some(rec));
             }
-            PsxCommand::Target(t) => {
-                self.target = *t;
-                self.send(now, Some(rec));
-            }
-            PsxCommand::Stamp { code, stamp } => {
+            Step::Stamp { code, stamp } => {
                 self.stamp = Some((*code, *stamp));
                 self.send(now, Some(rec));
             }
-            PsxCommand::Isdu(req) => {
-                self.drive.handle_isdu(now, req.clone());
+            Step::IsduRead { index, subindex } => {
+                let req = Request::Read {
+                    index: *index,
+                    subindex: *subindex,
+                };
+                self.drive.handle_isdu(now, req);
                 self.answers(rec);
             }
-            PsxCommand::Keys(k) => self.drive.handle_keys(now, *k),
-            PsxCommand::Link(ev) => self.drive.handle_link(now, *ev),
-            PsxCommand::PowerCycle => self.drive.power_cycle(now),
-            PsxCommand::Leds => {
+            Step::IsduWrite {
+                index,
+                subindex,
+                data,
+            } => {
+                let req = Request::Write {
+                    index: *index,
+                    subindex: *subindex,
+                    data: data.clone(),
+                };
+                self.drive.handle_isdu(now, req);
+                self.answers(rec);
+            }
+            Step::Keys { forward, reverse } => {
+                let keys = JogKeys {
+                    forward: *forward,
+                    reverse: *reverse,
+                };
+                self.drive.handle_keys(now, keys);
+            }
+            Step::Link { event } => self.drive.handle_link(now, *event),
+            Step::PowerCycle => self.drive.power_cycle(now),
+            // Refused by `unplayable` before the script plays.
+            Step::PdOut { .. }
+            | Step::Hold { .. }
+            | Step::Until { .. }
+            | Step::Advance { .. }
+            | Step::IsduPoll { .. }
+            | Step::Env { .. } => {}
+            Step::Leds => {
                 self.drive.advance(now);
                 let l = self.drive.leds();
                 let shown = format!(
@@ -447,7 +470,7 @@ impl<'s> Simulated for PsxSim<'s> {
 }
 
 /// Parses a script with the PSx3xx commands of `rules`.
-pub fn parse(rules: &Rules<'_>, text: &str) -> Result<Script<PsxCommand>, ScriptError> {
+pub fn parse(rules: &Rules<'_>, text: &str) -> Result<Script<Step>, ScriptError> {
     Script::parse(text, &PsxDialect::new(rules))
 }
 
@@ -462,7 +485,7 @@ pub fn run_text(
     let script = parse(drive.rules(), text)?;
     let model = drive.model_id().to_owned();
     let mut sim = PsxSim::new(drive);
-    let played = play(&mut sim, &script, opts);
+    let played = play(&mut sim, &script, opts)?;
     let bits = sim
         .drive
         .rules()

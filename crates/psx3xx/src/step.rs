@@ -1,4 +1,7 @@
-//! The PSx3xx step language of the `sequence` vectors (`spec/psx3xx/vectors`): what the
+//! The PSx3xx step language: [`Step`], one master action or environment change of a timed
+//! sequence (suite cases, scenario files, fuzz replay files, and the `sim-run` script, whose
+//! commands are a text form of it: [`crate::script`]), and the step language of the
+//! `sequence` vectors (`spec/psx3xx/vectors`): what the
 //! master sends (process data, ISDU), what the environment or the operator does (events, jog
 //! keys, the IO-Link connection) and what the drive must show after each step (manual 3.3,
 //! 4.4–4.6, 5.9–5.14; `spec/SCHEMA.md` "Steps and scenarios").
@@ -6,7 +9,8 @@
 //! Every record is `deny_unknown_fields`: a misspelt key is an error naming the key, and
 //! [`check_steps`] reports it as a `spec check` problem.
 
-use drivespec_positioner::step::{check_sequences, Sequence, State};
+use crate::model::LinkEvent;
+use drivespec_positioner::step::{check_sequences, SequenceInput, SequenceVector, State};
 use drivespec_spec::{Problem, Spec};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -81,7 +85,7 @@ pub enum Step {
         #[serde(default)]
         subindex: u8,
         /// The octets, written as hex text (`00 2A`).
-        #[serde(rename = "hex", with = "hex_text")]
+        #[serde(rename = "hex", with = "drivespec_positioner::step::hex_text")]
         data: Vec<u8>,
     },
     /// An environment change in the cyclic-exchange protocol's text form (`jam 1`,
@@ -90,6 +94,46 @@ pub enum Step {
         /// The change.
         env: String,
     },
+    /// New values in the active format's process output (absent: unchanged), then one cycle
+    /// (3.3.1): the control word (ISDU 110), the target (ISDU 112), the target speed in rpm
+    /// (format 2).
+    Process {
+        /// Control word.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        control: Option<u16>,
+        /// Target position.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        target: Option<i32>,
+        /// Target speed, rpm (format 2).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        speed: Option<i16>,
+    },
+    /// The format-0 output from now on: control code and time stamp (3.3.1, 4.4).
+    Stamp {
+        /// Control code (bits 0–1).
+        code: u8,
+        /// Time stamp (bits 2–15).
+        stamp: u16,
+    },
+    /// The jog key inputs (5.10).
+    Keys {
+        /// Forward key (pin 2) pressed.
+        #[serde(default)]
+        forward: bool,
+        /// Reverse key (pin 3) pressed.
+        #[serde(default)]
+        reverse: bool,
+    },
+    /// A change of the IO-Link communication (5.9).
+    Link {
+        /// The change.
+        event: LinkEvent,
+    },
+    /// Supply off and on again.
+    PowerCycle,
+    /// What the three LEDs show, read off the reference model (2.6, 3.3.1); a device under
+    /// test shows them to the eye only.
+    Leds,
 }
 
 fn is_zero_i32(v: &i32) -> bool {
@@ -104,21 +148,6 @@ fn is_zero_u16(v: &u16) -> bool {
     *v == 0
 }
 
-/// The octets of an ISDU write as hex text (`7E 21 02`).
-mod hex_text {
-    use drivespec_spec::hex::{parse_hex, to_hex};
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub(super) fn serialize<S: Serializer>(data: &[u8], s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(&to_hex(data))
-    }
-
-    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u8>, D::Error> {
-        let text = String::deserialize(d)?;
-        parse_hex(&text).map_err(serde::de::Error::custom)
-    }
-}
-
 impl Step {
     /// The `do` name of the step.
     pub fn name(&self) -> &'static str {
@@ -131,119 +160,91 @@ impl Step {
             Step::IsduPoll { .. } => "isdu-poll",
             Step::IsduWrite { .. } => "isdu-write",
             Step::Env { .. } => "env",
+            Step::Process { .. } => "process",
+            Step::Stamp { .. } => "stamp",
+            Step::Keys { .. } => "keys",
+            Step::Link { .. } => "link",
+            Step::PowerCycle => "power-cycle",
+            Step::Leds => "leds",
         }
     }
 }
 
 /// The `input` of a sequence vector.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Input {
     /// Process-data format made active before the first step (ISDU 116, 3.3.1).
-    #[serde(default)]
     pub format: Option<u8>,
     /// ISDU index to value, written before the first step (67: where the shaft stands).
-    #[serde(default)]
     pub state: State,
     /// The steps, in order.
-    #[serde(default)]
     pub steps: Vec<VectorStep>,
 }
 
 /// The `expect` of a sequence vector: what holds after the last step.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Final {
     /// The run in progress at the end.
-    #[serde(default)]
     pub final_run: Option<Run>,
     /// ISDU index to the value it reads at the end.
-    #[serde(default)]
     pub final_state: BTreeMap<String, i64>,
     /// The device ID at the end (ISDU 0, Direct Parameter page 1).
-    #[serde(default)]
     pub device_id: Option<u32>,
     /// Rows of the manual's table the vector stands for (a table kept in the spec, 5.10).
-    #[serde(default)]
     pub rows: Option<u32>,
 }
 
-/// A typed PSx3xx `sequence` vector.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PsxSequence {
-    /// Start state and steps.
-    pub input: Input,
-    /// What holds at the end.
-    pub expect: Final,
+impl SequenceInput for Input {
+    type Step = VectorStep;
 }
 
-impl Sequence for PsxSequence {
-    type Input = Input;
-    type Expect = Final;
-    type Step = VectorStep;
-    fn new(input: Input, expect: Final) -> PsxSequence {
-        PsxSequence { input, expect }
-    }
-}
+/// A typed PSx3xx `sequence` vector.
+pub type PsxSequence = SequenceVector<Input, Final>;
 
 /// One step of a `sequence` vector: at most one of each action, in the order process data,
 /// ISDU, event; then the expectations.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct VectorStep {
     /// A new process output in the active format.
-    #[serde(default)]
     pub pd: Option<ProcessData>,
     /// An ISDU request (3.1).
-    #[serde(default)]
     pub isdu: Option<IsduStep>,
     /// Something the environment does.
-    #[serde(default)]
     pub event: Option<Event>,
     /// For `manual-rotation-at-standstill`: the turn relative to the loop direction.
-    #[serde(default)]
     pub direction: Option<LoopSide>,
     /// For `manual-rotation-at-standstill`: how far, in steps.
-    #[serde(default)]
     pub steps: Option<i64>,
     /// The IO-Link connection is up (jog-key table, 5.10).
-    #[serde(default)]
     pub bus: Option<bool>,
     /// The control word sent while the connection is up (jog-key table, 5.10).
-    #[serde(default)]
     pub control_word: Option<u16>,
     /// The jog keys pressed (5.10).
-    #[serde(default)]
     pub key: Option<Key>,
     /// How long the keys are held, ms.
-    #[serde(default)]
     pub hold_ms: Option<u64>,
     /// For `connection-lost`: how long after it the expectations are checked, ms.
-    #[serde(default)]
     pub after_ms: Option<u64>,
     /// What the drive shows after the step.
-    #[serde(default)]
     pub expect: Expect,
 }
 
 /// A process output; the fields of the active format are used, the others are zero (3.3.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct ProcessData {
     /// Format 0: control code.
-    #[serde(default)]
     pub control: Option<u8>,
     /// Format 0: time stamp.
-    #[serde(default)]
     pub stamp: Option<u16>,
     /// Formats 1 and 2: control word.
-    #[serde(default)]
     pub control_word: Option<u16>,
     /// Formats 1 and 2: target.
-    #[serde(default)]
     pub target: Option<i32>,
     /// Format 2: target speed, rpm.
-    #[serde(default)]
     pub target_speed: Option<i16>,
 }
 
@@ -364,61 +365,44 @@ impl Run {
 
 /// What the drive shows after a step; absent keys are not checked.
 #[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(default, deny_unknown_fields)]
 pub struct Expect {
     /// The run in progress.
-    #[serde(default)]
     pub run: Option<Run>,
     /// The run's target.
-    #[serde(default)]
     pub target: Option<i64>,
     /// The run starts this many µs after the step, not earlier (time stamps, 4.4).
-    #[serde(default)]
     pub after_us: Option<u64>,
     /// Status bits set (3.5).
-    #[serde(default)]
     pub status_set: Vec<u32>,
     /// Status bits clear (3.5).
-    #[serde(default)]
     pub status_clear: Vec<u32>,
     /// `false`: the drive does not stop on the way (a new target in the same direction).
-    #[serde(default)]
     pub stop: Option<bool>,
     /// `false`: the run has no loop (one waypoint).
-    #[serde(rename = "loop", default)]
+    #[serde(rename = "loop")]
     pub reference_loop: Option<bool>,
     /// The set speed, rpm.
-    #[serde(default)]
     pub speed_rpm: Option<i64>,
     /// The ISDU whose value the holding torque takes at standstill.
-    #[serde(default)]
     pub torque_param: Option<String>,
     /// Whether the jog keys act (5.10).
-    #[serde(default)]
     pub keys_active: Option<bool>,
     /// A jog moves this many jog increments (ISDU 135).
-    #[serde(default)]
     pub steps: Option<i64>,
     /// The jog state is checked this many ms after the keys are pressed.
-    #[serde(default)]
     pub after_ms: Option<u64>,
     /// A forward jog ends here at the latest (the upper limit).
-    #[serde(default)]
     pub stop_at: Option<i64>,
     /// The direction a jog moves.
-    #[serde(default)]
     pub direction: Option<Direction>,
     /// The active process-data format.
-    #[serde(default)]
     pub active_format: Option<u8>,
     /// The value an ISDU read returns.
-    #[serde(default)]
     pub value: Option<i64>,
     /// The ISDU ErrorType of a write (0: accepted).
-    #[serde(default)]
     pub error: Option<i64>,
     /// Whether a guard entry suppressed the write (3.1 ISDU 66, 109, 111, 126).
-    #[serde(default)]
     pub suppressed: Option<bool>,
 }
 

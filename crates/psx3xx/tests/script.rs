@@ -1,5 +1,5 @@
-//! `sim-run` scripts on the PSx3xx reference drive: the family's commands parse with errors
-//! naming the line, and runs are deterministic.
+//! `sim-run` scripts on the PSx3xx reference drive: the family's commands parse into the
+//! family's steps with errors naming the line, and runs are deterministic.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -8,9 +8,9 @@
 )]
 
 use drivespec_positioner::script::{Action, LineError, RunOptions, What};
-use drivespec_psx3xx::isdu::Request;
-use drivespec_psx3xx::model::{DriveConfig, JogKeys, LinkEvent};
-use drivespec_psx3xx::script::{parse, run_text, PsxCommand};
+use drivespec_psx3xx::model::{DriveConfig, LinkEvent};
+use drivespec_psx3xx::script::{parse, run_text};
+use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::Rules;
 use drivespec_spec::{FamilyId, Spec};
 
@@ -24,39 +24,50 @@ fn family_commands_parse_and_errors_name_the_line() {
          3 ms: keys both\n4 ms: link lost\n5 ms: power-cycle\n",
     )
     .unwrap();
-    let cmds: Vec<PsxCommand> = s
-        .steps
+    let cmds: Vec<Step> = s
+        .lines
         .iter()
         .map(|st| match &st.action {
-            Action::Device(c) => c.clone(),
+            Action::Step(c) => c.clone(),
             other => panic!("{other:?}"),
         })
         .collect();
     assert_eq!(
         cmds[0],
-        PsxCommand::Control {
-            word: 0x14,
+        Step::Process {
+            control: Some(0x14),
             target: Some(60000),
             speed: Some(50)
         }
     );
     assert_eq!(
         cmds[1],
-        PsxCommand::Isdu(Request::Read {
+        Step::IsduRead {
             index: 64,
             subindex: 0
-        })
+        }
     );
     assert_eq!(
         cmds[2],
-        PsxCommand::Stamp {
+        Step::Stamp {
             code: 3,
             stamp: 100
         }
     );
-    assert_eq!(cmds[3], PsxCommand::Keys(JogKeys::BOTH));
-    assert_eq!(cmds[4], PsxCommand::Link(LinkEvent::Lost));
-    assert_eq!(cmds[5], PsxCommand::PowerCycle);
+    assert_eq!(
+        cmds[3],
+        Step::Keys {
+            forward: true,
+            reverse: true
+        }
+    );
+    assert_eq!(
+        cmds[4],
+        Step::Link {
+            event: LinkEvent::Lost
+        }
+    );
+    assert_eq!(cmds[5], Step::PowerCycle);
 
     for (text, line) in [
         ("0 ms: keys sideways\n", 1),

@@ -126,4 +126,14 @@ impl Readings {
             .find(|e| e.option.as_deref() == Some(option))
             .map(|e| e.adopted.as_str())
     }
+
+    /// The reading of `option` in force, `adopted` when the family has no such option.
+    pub fn reading_or<'f>(
+        &'f self,
+        family: &'f crate::Family,
+        option: &str,
+        adopted: &'f str,
+    ) -> &'f str {
+        self.reading(family, option).unwrap_or(adopted)
+    }
 }

@@ -155,6 +155,12 @@ impl Family {
         })
     }
 
+    /// The ids of the family's models, comma-separated (an error naming the models there are).
+    pub fn model_ids(&self) -> String {
+        let ids: Vec<&str> = self.models.iter().map(|m| m.id.as_str()).collect();
+        ids.join(", ")
+    }
+
     /// The model matching `query` forgivingly (see `spec/SCHEMA.md`).
     pub fn model(&self, query: &str) -> Option<&DeviceModel> {
         let q = fold(query);

@@ -1,5 +1,6 @@
 //! Running the `drivespec` binary in the command-line tests: a run's exit code and output, a
-//! `drivespec sim` process that is killed when dropped, and per-process temporary folders.
+//! `drivespec sim` process that is killed when dropped, per-process temporary folders, and
+//! the checks of a `drivespec fuzz` run that finds nothing.
 //!
 //! The binary's path comes from the test crate (`env!("CARGO_BIN_EXE_drivespec")`). Test
 //! code: a failure to start, feed or wait for the binary panics with the reason, which is how
@@ -117,4 +118,41 @@ impl Drop for Sim {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// Runs `bin fuzz FAMILY [ARGS] --iterations N --seed 3` against the built-in model and checks
+/// a clean run: exit 0, N sequences and no finding, the simulated `model` named, progress on
+/// stderr, `fuzz.json`, `fuzz.junit.xml` and `fuzz.html` written, and `class` among the
+/// classes of the JSON report.
+pub fn fuzz_finds_nothing(
+    bin: &str,
+    family: &str,
+    args: &[&str],
+    model: &str,
+    iterations: u32,
+    class: &str,
+) {
+    let out = temp_dir(&format!("fuzz-{family}-cli"), "sim");
+    let dir = out.display().to_string();
+    let n = iterations.to_string();
+    let mut argv = vec!["fuzz", family];
+    argv.extend_from_slice(args);
+    argv.extend_from_slice(&["--iterations", &n, "--seed", "3", "--out", &dir]);
+    let (code, stdout, stderr) = run(bin, &argv);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    assert!(
+        stdout.contains(&format!("{n} sequence(s)")) && stdout.contains("0 finding(s)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains(&format!("sim:{model}")), "{stdout}");
+    assert!(
+        stderr.contains(&format!("fuzz {family}: {n}/{n} sequences")),
+        "{stderr}"
+    );
+    for f in ["fuzz.json", "fuzz.junit.xml", "fuzz.html"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let json = std::fs::read_to_string(out.join("fuzz.json")).expect("read fuzz.json");
+    assert!(json.contains(&format!("\"{class}\"")), "{json}");
+    std::fs::remove_dir_all(&out).expect("remove the output folder");
 }

@@ -1519,7 +1519,7 @@ pub(crate) fn generate(
     for (info, case) in &g.out {
         for s in &case.steps {
             if let Step::Env { env } = &s.action {
-                if super::session::env_request(0, env).is_none() {
+                if crate::cyclic_session::env_request(0, env).is_err() {
                     g.errors
                         .push(format!("{}: env {env:?} is not an injection", info.id));
                 }

@@ -4,8 +4,8 @@
 use super::cases::{status_bit, OpenPoint, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{CaseInfo, Finding};
-use crate::cyclic::{Reply, Request, Server};
-use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Op, Tolerance};
+use crate::cyclic::{Env, Reply, Request, Server};
+use crate::cyclic_session::{env_op, same_length, CyclicFamily, CyclicSession, Op, Tolerance};
 use drivespec_psd4xx::pkw::Reply as PkwReply;
 use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::{Input, Output, PkwRequest, PkwResponse};
@@ -309,9 +309,20 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
                 index: *index,
                 data: hex.clone(),
             }),
-            // Built steps carry checked text; an unchecked one holds for no cycle.
-            Step::Env { env } => env_request(t, env).map_or(Op::Hold(0), Op::Exchange),
+            Step::Env { env } => env_op(t, env),
             Step::Advance { us } => Op::Advance(*us),
+            Step::Link { event } => Op::Exchange(Request::Env {
+                t,
+                env: Env::Link(*event),
+            }),
+            Step::PowerCycle => Op::Exchange(Request::Env {
+                t,
+                env: Env::PowerCycle,
+            }),
+            Step::Par { .. } => Op::Refuse(
+                "a `par` step writes into the reference model directly; a device has no such access"
+                    .to_owned(),
+            ),
         }
     }
 
@@ -424,14 +435,5 @@ impl Psd4xx<'_, '_> {
         }
         d.pkw = reference.get(start)?.pkw;
         Some(d)
-    }
-}
-
-/// The `ENV` request of an environment step's text at time `t`; None when the text is not an
-/// injection (suite and replay steps are checked with it when they are built).
-pub(crate) fn env_request(t: u64, text: &str) -> Option<Request> {
-    match Request::parse(&format!("ENV {t} {text}")) {
-        Ok(r @ Request::Env { .. }) => Some(r),
-        _ => None,
     }
 }

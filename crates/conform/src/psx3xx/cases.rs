@@ -7,9 +7,9 @@
 mod scenario;
 mod sequence;
 
-use super::session::env_request;
 use crate::case::{CaseInfo, Role};
 use crate::cyclic::Env;
+use crate::cyclic_session::env_request;
 use drivespec_psx3xx::guard::Guards;
 use drivespec_psx3xx::isdu::{Target, Value};
 use drivespec_psx3xx::model::Drive;

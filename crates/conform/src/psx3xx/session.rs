@@ -4,10 +4,13 @@
 use super::cases::{PsxCase, StepDef};
 use super::Psx3xxSuite;
 use crate::case::CaseInfo;
-use crate::cyclic::WireError;
-use crate::cyclic::{Reply, Request, Server};
-use crate::cyclic_session::{same_length, CyclicFamily, CyclicSession, Live, Op, Tolerance};
+use crate::cyclic::{Env, Reply, Request, Server};
+use crate::cyclic_session::{
+    env_op, same_length, CyclicFamily, CyclicSession, Live, Op, Tolerance,
+};
+use drivespec_psd4xx::model::LinkEvent as BusEvent;
 use drivespec_psx3xx::isdu::ErrorType;
+use drivespec_psx3xx::model::LinkEvent;
 use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
 use drivespec_spec::{DataType, Family, FamilyId};
@@ -282,7 +285,8 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         Some((*kind, value))
     }
 
-    fn op(&self, action: &Step, _out: &Output, _last: Option<&Input>, t: u64) -> Op<Output> {
+    fn op(&self, action: &Step, out: &Output, _last: Option<&Input>, t: u64) -> Op<Output> {
+        let env = |env| Op::Exchange(Request::Env { t, env });
         match action {
             Step::PdOut {
                 format,
@@ -327,9 +331,35 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
                 subindex: *subindex,
                 data: data.clone(),
             }),
-            // The suite builds no case whose environment text does not parse
-            // ([`env_request`]); such a step would cycle zero times.
-            Step::Env { env } => env_request(t, env).map_or(Op::Hold(0), Op::Exchange),
+            Step::Env { env } => env_op(t, env),
+            Step::Process {
+                control,
+                target,
+                speed,
+            } => Op::Send {
+                out: changed(*out, *control, *target, *speed),
+                max: 1,
+            },
+            Step::Stamp { code, stamp } => Op::Send {
+                out: Output::TimeStamp {
+                    control: TsCode(*code),
+                    stamp: Stamp(*stamp),
+                },
+                max: 1,
+            },
+            Step::Keys { forward, reverse } => env(Env::Keys {
+                forward: *forward,
+                reverse: *reverse,
+            }),
+            Step::Link { event } => env(Env::Link(match event {
+                LinkEvent::Connected => BusEvent::Connected,
+                LinkEvent::Lost => BusEvent::Lost,
+            })),
+            Step::PowerCycle => env(Env::PowerCycle),
+            Step::Leds => Op::Refuse(
+                "an `leds` step reads the reference model's LEDs; a device shows them to the eye only"
+                    .to_owned(),
+            ),
         }
     }
 
@@ -339,14 +369,33 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
     }
 }
 
-/// The `ENV` request at `t` for an environment change in its text form (`jam 1`).
-pub(crate) fn env_request(t: u64, env: &str) -> Result<Request, WireError> {
-    match Request::parse(&format!("ENV {t} {env}"))? {
-        r @ Request::Env { .. } => Ok(r),
-        _ => Err(WireError {
-            line: env.to_owned(),
-            what: String::from("not an environment change"),
-        }),
+/// `out` with the control word, target and target speed a `process` step gives (absent:
+/// unchanged); a format-0 output becomes format 1 with the control word, or stays as it is.
+fn changed(out: Output, control: Option<u16>, target: Option<i32>, speed: Option<i16>) -> Output {
+    match out {
+        Output::TimeStamp { .. } => match control {
+            Some(control_word) => Output::ControlTarget {
+                control_word,
+                target: target.unwrap_or(0),
+            },
+            None => out,
+        },
+        Output::ControlTarget {
+            control_word,
+            target: t,
+        } => Output::ControlTarget {
+            control_word: control.unwrap_or(control_word),
+            target: target.unwrap_or(t),
+        },
+        Output::SpeedControlTarget {
+            target_speed,
+            control_word,
+            target: t,
+        } => Output::SpeedControlTarget {
+            target_speed: speed.unwrap_or(target_speed),
+            control_word: control.unwrap_or(control_word),
+            target: target.unwrap_or(t),
+        },
     }
 }
 

@@ -7,7 +7,7 @@
 //! The generator draws only from the [`Rng`] it is given; nothing here reads a clock or the
 //! device. Nothing panics: a message that cannot be built is skipped.
 
-use crate::engine::{below, chance, pick};
+use crate::engine::{self, below, chance, pick, templates};
 use crate::replay::{self, Step};
 use drivespec_conform::case::Role;
 use drivespec_conform::hpd::cases::{BitRef, CaseB, Gen, GenError};
@@ -40,59 +40,13 @@ struct Bit<'s> {
     reqs: Vec<&'s str>,
 }
 
-/// The templates a sequence is made of, with their weights (README "What is generated (HPD)").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Template {
-    Read,
-    Write,
-    ModeWrite,
-    ReadOnlyWrite,
-    Bit,
-    RawBit,
-    Command,
-    Broadcast,
-    Foreign,
-    BadChecksum,
-    BadStuffing,
-    Truncated,
-    OverLong,
-    WrongLun,
-    Split,
-    Noise,
-    PlcRead,
-    PlcProgram,
-    PlcWriteRunning,
-    Inputs,
-    PowerCycle,
-    Listen,
-    Dword,
+templates! {
+    /// The templates a sequence is made of, with their weights (README "What is generated (HPD)").
+    Read = 9, Write = 14, ModeWrite = 4, ReadOnlyWrite = 4, Bit = 8, RawBit = 3, Command = 6,
+    Broadcast = 4, Foreign = 4, BadChecksum = 4, BadStuffing = 4, Truncated = 3, OverLong = 3,
+    WrongLun = 3, Split = 5, Noise = 3, PlcRead = 3, PlcProgram = 7, PlcWriteRunning = 2,
+    Inputs = 3, PowerCycle = 1, Listen = 2, Dword = 3
 }
-
-const TEMPLATES: [(Template, u32); 23] = [
-    (Template::Read, 9),
-    (Template::Write, 14),
-    (Template::ModeWrite, 4),
-    (Template::ReadOnlyWrite, 4),
-    (Template::Bit, 8),
-    (Template::RawBit, 3),
-    (Template::Command, 6),
-    (Template::Broadcast, 4),
-    (Template::Foreign, 4),
-    (Template::BadChecksum, 4),
-    (Template::BadStuffing, 4),
-    (Template::Truncated, 3),
-    (Template::OverLong, 3),
-    (Template::WrongLun, 3),
-    (Template::Split, 5),
-    (Template::Noise, 3),
-    (Template::PlcRead, 3),
-    (Template::PlcProgram, 7),
-    (Template::PlcWriteRunning, 2),
-    (Template::Inputs, 3),
-    (Template::PowerCycle, 1),
-    (Template::Listen, 2),
-    (Template::Dword, 3),
-];
 
 /// The HPD sequence generator.
 pub(crate) struct HpdGen<'a, 's> {
@@ -607,19 +561,7 @@ impl<'a, 's> HpdGen<'a, 's> {
             Template::PowerCycle => self.caps.power_cycle,
             _ => true,
         };
-        let total: u32 = TEMPLATES
-            .iter()
-            .filter(|(t, _)| usable(*t))
-            .map(|(_, w)| *w)
-            .sum();
-        let mut x = u32::try_from(rng.range(0, i64::from(total.max(1)) - 1)).unwrap_or(0);
-        for (t, w) in TEMPLATES.iter().filter(|(t, _)| usable(*t)) {
-            if x < *w {
-                return *t;
-            }
-            x -= w;
-        }
-        Template::Read
+        engine::weighted(rng, TEMPLATES, usable, Template::Read)
     }
 
     fn action(&mut self, rng: &mut Rng, t: Template, out: &mut Vec<Step>) {

@@ -12,7 +12,7 @@
 //! requirement ID a step names is checked against the spec when the generator is built.
 
 use crate::cyclic_target::env_kind;
-use crate::engine::{self, below, chance, pick};
+use crate::engine::{self, below, chance, pick, templates};
 use crate::replay::{Action, Step};
 use drivespec_conform::cyclic::Env;
 use drivespec_conform::psd4xx::cases::{control, control_bit};
@@ -29,71 +29,14 @@ const MAX_STEPS: usize = 40;
 /// Most cycles a wait for running or standstill takes (15 s of bus time at 10 ms).
 const WAIT_MAX: u32 = 1_500;
 
-/// Templates and their weights.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Template {
-    Read,
-    Write,
-    OutOfRange,
-    ReadOnly,
-    UnknownPnu,
-    AnyAk,
-    IndOnScalar,
-    BadSubindex,
-    WrongType,
-    Spm,
-    Handshake,
-    Par96,
-    Reserved,
-    Invalid,
-    Toggle,
-    Position,
-    BeyondLimits,
-    LoopPastLimit,
-    Manual,
-    ReleaseWithdrawn,
-    NewTarget,
-    TransferWithoutRelease,
-    Scaling,
-    RecordRead,
-    RecordWrite,
-    RecordBad,
-    Environment,
-    Obstruction,
-    Advance,
+templates! {
+    /// Templates and their weights.
+    Read = 8, Write = 8, OutOfRange = 6, ReadOnly = 4, UnknownPnu = 3, AnyAk = 5, IndOnScalar = 3,
+    BadSubindex = 2, WrongType = 3, Spm = 2, Handshake = 6, Par96 = 2, Reserved = 4, Invalid = 4,
+    Toggle = 4, Position = 8, BeyondLimits = 3, LoopPastLimit = 2, Manual = 5, ReleaseWithdrawn = 4,
+    NewTarget = 4, TransferWithoutRelease = 2, Scaling = 3, RecordRead = 5, RecordWrite = 5,
+    RecordBad = 4, Environment = 6, Obstruction = 3, Advance = 2
 }
-
-const TEMPLATES: [(Template, u32); 29] = [
-    (Template::Read, 8),
-    (Template::Write, 8),
-    (Template::OutOfRange, 6),
-    (Template::ReadOnly, 4),
-    (Template::UnknownPnu, 3),
-    (Template::AnyAk, 5),
-    (Template::IndOnScalar, 3),
-    (Template::BadSubindex, 2),
-    (Template::WrongType, 3),
-    (Template::Spm, 2),
-    (Template::Handshake, 6),
-    (Template::Par96, 2),
-    (Template::Reserved, 4),
-    (Template::Invalid, 4),
-    (Template::Toggle, 4),
-    (Template::Position, 8),
-    (Template::BeyondLimits, 3),
-    (Template::LoopPastLimit, 2),
-    (Template::Manual, 5),
-    (Template::ReleaseWithdrawn, 4),
-    (Template::NewTarget, 4),
-    (Template::TransferWithoutRelease, 2),
-    (Template::Scaling, 3),
-    (Template::RecordRead, 5),
-    (Template::RecordWrite, 5),
-    (Template::RecordBad, 4),
-    (Template::Environment, 6),
-    (Template::Obstruction, 3),
-    (Template::Advance, 2),
-];
 
 /// A parameter as the generator uses it.
 #[derive(Debug, Clone)]
@@ -337,19 +280,7 @@ impl PsdGen {
             Template::Obstruction => self.takes("jam"),
             _ => true,
         };
-        let total: u32 = TEMPLATES
-            .iter()
-            .filter(|(t, _)| usable(*t))
-            .map(|(_, w)| *w)
-            .sum();
-        let mut x = u32::try_from(rng.range(0, i64::from(total.max(1)) - 1)).unwrap_or(0);
-        for (t, w) in TEMPLATES.iter().filter(|(t, _)| usable(*t)) {
-            if x < *w {
-                return *t;
-            }
-            x -= w;
-        }
-        Template::Read
+        engine::weighted(rng, TEMPLATES, usable, Template::Read)
     }
 
     fn push(&self, out: &mut Vec<Step>, t: Template, step: PsdStep, text: String) {

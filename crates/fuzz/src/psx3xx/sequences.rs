@@ -15,7 +15,7 @@
 //! [`Rng`] only; every requirement ID a step names is checked against the spec when the
 //! generator is built.
 
-use crate::engine::{self, below, chance, pick};
+use crate::engine::{self, below, chance, pick, templates};
 use crate::replay::{Action, Step};
 use drivespec_conform::cyclic::Env;
 use drivespec_conform::psx3xx::Psx3xxSuite;
@@ -44,51 +44,13 @@ const STANDARD_COMMAND: &str = "2";
 /// ISDU 193, delivery state and save command.
 const DELIVERY_STATE: &str = "193";
 
-/// Templates and their weights.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Template {
-    Read,
-    Write,
-    OutOfRange,
-    ReadOnly,
-    UnknownIndex,
-    UnknownSubindex,
-    Length,
-    Guard,
-    StandardCommand,
-    DeliveryState,
-    SavePowerCycle,
-    FormatSwitch,
-    Position,
-    Control,
-    Speed,
-    Stamp,
-    Keys,
-    Environment,
-    Silence,
+templates! {
+    /// Templates and their weights.
+    Read = 6, Write = 8, OutOfRange = 6, ReadOnly = 4, UnknownIndex = 3, UnknownSubindex = 3,
+    Length = 3, Guard = 5, StandardCommand = 4, DeliveryState = 3, SavePowerCycle = 4,
+    FormatSwitch = 4, Position = 7, Control = 5, Speed = 6, Stamp = 7, Keys = 4, Environment = 6,
+    Silence = 4
 }
-
-const TEMPLATES: [(Template, u32); 19] = [
-    (Template::Read, 6),
-    (Template::Write, 8),
-    (Template::OutOfRange, 6),
-    (Template::ReadOnly, 4),
-    (Template::UnknownIndex, 3),
-    (Template::UnknownSubindex, 3),
-    (Template::Length, 3),
-    (Template::Guard, 5),
-    (Template::StandardCommand, 4),
-    (Template::DeliveryState, 3),
-    (Template::SavePowerCycle, 4),
-    (Template::FormatSwitch, 4),
-    (Template::Position, 7),
-    (Template::Control, 5),
-    (Template::Speed, 6),
-    (Template::Stamp, 7),
-    (Template::Keys, 4),
-    (Template::Environment, 6),
-    (Template::Silence, 4),
-];
 
 /// Requirement IDs of each template (checked against the spec in [`PsxGen::new`]).
 fn reqs(t: Template) -> &'static [&'static str] {
@@ -442,19 +404,7 @@ impl<'s> PsxGen<'s> {
             Template::Environment => !self.envs.is_empty(),
             _ => true,
         };
-        let total: u32 = TEMPLATES
-            .iter()
-            .filter(|(t, _)| usable(*t))
-            .map(|(_, w)| *w)
-            .sum();
-        let mut x = u32::try_from(rng.range(0, i64::from(total.max(1)) - 1)).unwrap_or(0);
-        for (t, w) in TEMPLATES.iter().filter(|(t, _)| usable(*t)) {
-            if x < *w {
-                return *t;
-            }
-            x -= w;
-        }
-        Template::Read
+        engine::weighted(rng, TEMPLATES, usable, Template::Read)
     }
 
     fn push(&self, out: &mut Vec<Step>, t: Template, step: PsxStep, text: String) {

@@ -142,18 +142,12 @@ impl PsdFamily {
             .model(&config.model)
             .ok_or_else(|| ModelError::UnknownModel {
                 model: config.model.clone(),
-                known: family
-                    .models
-                    .iter()
-                    .map(|m| m.id.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known: family.model_ids(),
             })?;
-        let reading = |option: &str, adopted: &str| -> String {
+        let reading = |option: &str, adopted: &'static str| {
             config
                 .readings
-                .reading(family, option)
-                .unwrap_or(adopted)
+                .reading_or(family, option, adopted)
                 .to_owned()
         };
         let roles = roles(family, p)?;

@@ -3,10 +3,10 @@
 
 use crate::{DecodeError, ErrorCode};
 use drivespec_positioner::{CoreEvent, Micros};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A change of the connection to the IO controller (manual 3.9, 4.9).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinkEvent {
     /// The controller connects (again); images are processed from now on (3.9).

@@ -5,10 +5,10 @@
 use crate::isdu::{Response, Value};
 use drivespec_positioner::{CoreEvent, Micros};
 use drivespec_spec::psx3xx::RunAction;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A change of the IO-Link communication (manual 5.9, 5.10 table).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinkEvent {
     /// The master is in OPERATE again; images and ISDU requests are processed (4.1).
