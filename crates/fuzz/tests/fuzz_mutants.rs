@@ -21,16 +21,25 @@ use support::mutants::{mutants, spec, strict_readings, Kind, Mutant};
 const BOUND: u64 = 80;
 
 /// Sequences for deviations only a rarely drawn input shows: a Pr31 value in a gap of its
-/// range (a mode write with an out-of-range value) and a FIN after another instruction (a
-/// PLC program uploaded and run).
+/// range (a mode write with an out-of-range value), a FIN after another instruction or a DIV
+/// (one PLC program of the spec's many uploaded and run), a write refused while b99.7 is set.
 const RARE_BOUND: u64 = 320;
 
 /// The sequences `kind` gets.
 fn bound(kind: Kind) -> u64 {
     match kind {
-        Kind::FinAnywhere | Kind::Reading("pr31-range", _) => RARE_BOUND,
+        Kind::FinAnywhere | Kind::Reading("pr31-range" | "div-remainder" | "b99-7-scope", _) => {
+            RARE_BOUND
+        }
         _ => BOUND,
     }
+}
+
+/// Whether the fuzzer hunts `kind`: user flags kept over a power cycle show only when flags
+/// set, then a power cycle, then a read of Pb91 come in that order, which the suite's
+/// `hpd/cmd/power-up/Pb91` does and the fuzzer's HPD sequences (no power cycle) never do.
+fn hunted(kind: Kind) -> bool {
+    kind != Kind::KeepsVolatileFlags
 }
 
 #[test]
@@ -42,7 +51,7 @@ fn every_mutant_is_found_with_a_short_replay() {
         progress: Progress::Quiet,
         ..Options::default()
     };
-    let all = mutants();
+    let all: Vec<_> = mutants().into_iter().filter(|m| hunted(m.kind)).collect();
     let results: Vec<(String, Kind, fuzz::Summary)> = std::thread::scope(|s| {
         let handles: Vec<_> = all
             .iter()
