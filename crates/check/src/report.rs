@@ -580,6 +580,11 @@ impl Report {
                 offset: None,
             });
         } else {
+            // First among the notes, which stay at most MAX_NOTES.
+            if self.notes.len() >= MAX_NOTES {
+                self.notes.pop();
+                self.notes_dropped += 1;
+            }
             self.notes.insert(0, said);
         }
     }
