@@ -1291,8 +1291,17 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         .reference
                         .and_then(|t| run.cycles.get(t))
                         .map_or(&c.reference, |r| &r.reference);
-                    let mut reqs = f.breaks.clone();
-                    reqs.extend(run.reqs.iter().filter(|r| !f.breaks.contains(r)).cloned());
+                    // A case that checks one requirement names it first: what it finds
+                    // breaks that requirement; the status bit's own rules follow.
+                    let mut reqs: Vec<String> = match run.reqs {
+                        [only] => vec![only.clone()],
+                        _ => Vec::new(),
+                    };
+                    for r in f.breaks.iter().chain(run.reqs) {
+                        if !reqs.contains(r) {
+                            reqs.push(r.clone());
+                        }
+                    }
                     run.failed_cycle = Some(f.cycle);
                     run.failure =
                         Some(self.cycle_failure(&reqs, f.cycle, c, reference, f.what.clone()));

@@ -17,12 +17,13 @@ use drivespec_conform::psx3xx::Psx3xxSuite;
 use drivespec_conform::select::Pattern;
 use drivespec_conform::suite::{Session, Settings, Suite};
 use support::mutants::spec;
-use support::psx3xx_mutants::{mutants, Kind, Mutant};
+use support::psx3xx_mutants::{mutants, suite_mutants, Kind, Mutant};
 
 #[test]
 fn every_psx3xx_mutant_fails_the_cases_covering_its_deviation() {
     let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
-    let all = mutants();
+    let single: Vec<&str> = suite_mutants().iter().map(|m| m.name).collect();
+    let all: Vec<_> = mutants().into_iter().chain(suite_mutants()).collect();
     let mut caught = 0;
     let mut problems = Vec::new();
     let mut report = Vec::new();
@@ -38,6 +39,24 @@ fn every_psx3xx_mutant_fails_the_cases_covering_its_deviation() {
                     .requirements
                     .iter()
                     .any(|r| breaks.iter().any(|b| b.matches(&r.id)));
+                // A mutant of a case that checks one requirement fails it naming that first.
+                let first = f
+                    .requirements
+                    .first()
+                    .is_some_and(|r| breaks.iter().any(|b| b.matches(&r.id)));
+                let checked_alone = m.must_fail.iter().any(|w| {
+                    Pattern::new(w).unwrap().matches(&info.id) && info.requirements.len() == 1
+                });
+                if single.contains(&m.name) && checked_alone && !first {
+                    problems.push(format!(
+                        "{}: {} failed citing {:?} first, not {:?}: {}",
+                        m.name,
+                        info.id,
+                        f.requirements.first().map(|r| r.id.clone()),
+                        m.breaks,
+                        f.message
+                    ));
+                }
                 if !cited {
                     problems.push(format!(
                         "{}: {} failed without citing {:?} (cites {:?}): {}",

@@ -125,6 +125,7 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
                 .collect(),
             tol: if moves { MOTION } else { EXACT },
             plot: false,
+            open: None,
         };
         (info, case)
     }

@@ -8,11 +8,27 @@ use drivespec_spec::{FamilyId, Problem, Spec};
 use serde::Deserialize;
 
 /// How a scenario is judged (`setup` of a PSx3xx scenario).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Setup {
     /// The tolerance and plot of the case.
     pub judge: Judge,
+    /// Status bits the manual leaves open in the case, not judged (a motion case).
+    #[serde(default)]
+    pub open: Option<Open>,
+}
+
+/// Status bits a scenario does not judge because the manual leaves them open there; the case
+/// reports what the device showed.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Open {
+    /// The requirement the point belongs to.
+    pub requirement: String,
+    /// What the manual leaves open, one line.
+    pub text: String,
+    /// The status bits not judged (0..15).
+    pub bits: Vec<u16>,
 }
 
 /// The tolerance a scenario is judged with.

@@ -35,7 +35,7 @@ mod isdu {
 /// One step of a case.
 pub type StepDef = crate::cyclic_session::StepDef<Step>;
 
-pub use crate::cyclic_session::{Tolerance, MOTION};
+pub use crate::cyclic_session::{OpenPoint, Tolerance, MOTION};
 
 /// Tolerance of the ISDU cases: every cycle and every live value exact.
 pub const EXACT: Tolerance = Tolerance {
@@ -57,6 +57,8 @@ pub struct PsxCase {
     pub tol: Tolerance,
     /// Whether the report gets a position/speed/status plot.
     pub plot: bool,
+    /// The point of a motion case the manual leaves open, if any.
+    pub open: Option<OpenPoint>,
 }
 
 /// A process output in the format of `out`, then one cycle (manual 3.3.1).
@@ -209,6 +211,7 @@ impl<'a, 's> Gen<'a, 's> {
                 steps,
                 tol: EXACT,
                 plot: false,
+                open: None,
             },
         );
     }
@@ -224,6 +227,7 @@ impl<'a, 's> Gen<'a, 's> {
                 steps,
                 tol: MOTION,
                 plot: true,
+                open: None,
             },
         );
     }
@@ -430,6 +434,7 @@ impl<'a, 's> Gen<'a, 's> {
                     )],
                     tol: EXACT,
                     plot: false,
+                    open: None,
                 },
             );
             if p.access == Access::R {
@@ -460,6 +465,7 @@ impl<'a, 's> Gen<'a, 's> {
                         ],
                         tol: EXACT,
                         plot: false,
+                        open: None,
                     },
                 );
             }
@@ -562,6 +568,7 @@ impl<'a, 's> Gen<'a, 's> {
                     steps,
                     tol: EXACT,
                     plot: false,
+                    open: None,
                 },
             );
         }
@@ -1415,6 +1422,27 @@ impl<'a, 's> Gen<'a, 's> {
             "timestamp/position",
             &["PSX-TS-010", "PSX-TS-005", "PSX-TS-008", "PSX-TS-001"],
             "positioning by time stamp: executed the stamp's delay after the field turns inactive",
+            steps,
+        );
+        let mut steps = self.switch_to(0, Role::Setup);
+        steps.push(step(Role::Check, "stamp inactive", self.f0(0, inactive)));
+        steps.extend(self.write(Role::Check, &target_param, target));
+        steps.extend([
+            step(
+                Role::Check,
+                format!("code 3, stamp {}: no new time stamp", inactive.0),
+                self.f0(3, inactive),
+            ),
+            step(Role::Check, "nothing runs", Step::Hold { cycles: 30 }),
+            step(Role::Check, "code 3, stamp 2500", self.f0(3, Stamp(2500))),
+            step(Role::Check, "stamp inactive", self.f0(3, inactive)),
+            step(Role::Check, "until running", Self::until(true)),
+            step(Role::Check, "until standstill", Self::until(false)),
+        ]);
+        self.motion(
+            "timestamp/inactive-value",
+            &["PSX-TS-002"],
+            "the stamp value 0x3FFF is no time stamp: a control code with it runs nothing; a valid stamp then runs when the field turns inactive",
             steps,
         );
         let mut steps = self.switch_to(0, Role::Setup);

@@ -6,7 +6,7 @@ use super::Psx3xxSuite;
 use crate::case::CaseInfo;
 use crate::cyclic::{Env, Reply, Request, Server};
 use crate::cyclic_session::{
-    env_op, same_length, CyclicFamily, CyclicSession, Live, Op, Tolerance,
+    env_op, same_length, CyclicFamily, CyclicSession, Live, Op, OpenPoint, Tolerance,
 };
 use drivespec_psd4xx::model::LinkEvent as BusEvent;
 use drivespec_psx3xx::isdu::ErrorType;
@@ -28,6 +28,9 @@ pub struct Psx3xx<'a, 's> {
     /// motion case against the device's own process data.
     live: Vec<(u16, Live)>,
 }
+
+/// The requirement that multi-byte process values come most significant byte first (3.3.2).
+const BYTE_ORDER: &str = "PSX-PD-008";
 
 /// The status bit the runner waits on (manual 3.4 bit 6).
 const RUNNING: &str = "Drive is running";
@@ -153,6 +156,10 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         case.start
     }
 
+    fn open(case: &PsxCase) -> Option<OpenPoint> {
+        case.open.clone()
+    }
+
     fn cycle_us(&self) -> u64 {
         self.suite.cycle_us()
     }
@@ -214,9 +221,18 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         self.running_bit
     }
 
-    /// The case's requirements.
-    fn cited(&self, case: &[String], _dut: Option<&Input>, _reference: &Input) -> Vec<String> {
-        case.to_vec()
+    /// The case's requirements; first the byte order of the process data (PSX-PD-008) when
+    /// the device's status word is the reference's with its two octets swapped.
+    fn cited(&self, case: &[String], dut: Option<&Input>, reference: &Input) -> Vec<String> {
+        let swapped = dut.is_some_and(|d| {
+            d.status != reference.status && d.status == reference.status.swap_bytes()
+        });
+        let mut ids: Vec<String> = Vec::new();
+        if swapped {
+            ids.push(BYTE_ORDER.to_owned());
+        }
+        ids.extend(case.iter().filter(|r| r.as_str() != BYTE_ORDER).cloned());
+        ids
     }
 
     /// The reference's reply exactly, or for an ISDU error the same ErrorType (named or hex)

@@ -12,6 +12,14 @@ use drivespec_psx3xx::model::Drive;
 use drivespec_psx3xx::{Guards, Output, Stamp};
 use drivespec_spec::{Access, Readings};
 
+/// The 3-revolution safety margin at the delivery scaling, steps (5.5 comment 1).
+const MARGIN: i64 = 1200;
+/// The encoder's 256 revolutions at the delivery scaling, steps (5.5, 5.6.1).
+const ENCODER: i64 = 102_400;
+
+/// The time-stamp control code of a positioning run (3.3.1).
+const POSITIONING_CODE: u8 = 3;
+
 /// The planted deviations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
@@ -55,6 +63,23 @@ pub enum Kind {
     /// ISDU reads of the actual position come 5 steps off: within the motion cases' position
     /// tolerance, not within the exact ISDU cases.
     LivePositionOffset,
+    /// Control code 3 with the stamp 0x3FFF is executed at once when the code changes.
+    InactiveStampRuns,
+    /// Turning against the loop after a run stopped by withdrawing the release readjusts.
+    ReadjustAfterAbort,
+    /// Control bit 10 is taken as set: the release alone enables the readjustment.
+    ReadjustBitIgnored,
+    /// With control bits 4 and 5 both set, the jog keys are active (bit 5 wins).
+    JogKeysWithRelease,
+    /// A jog run goes on when the release replaces the jog release, until it stops by itself.
+    JogKeptOnRelease,
+    /// A target in a safety margin runs to the nearest limit instead of being refused.
+    MarginTargetToLimit,
+    /// Limit writes into the 3-revolution safety margins are acknowledged (and dropped).
+    LimitIntoMarginAccepted,
+    /// The status word is sent least significant byte first, the other values most
+    /// significant byte first.
+    StatusBytesSwapped,
 }
 
 /// The reference drive with one planted deviation.
@@ -64,6 +89,12 @@ pub struct Mutant<'s> {
     kind: Kind,
     /// The time stamp armed last (time-stamp mutant).
     armed: Option<(u8, u16)>,
+    /// The last format-0 output (inactive-stamp mutant).
+    last_stamp: Option<(u8, u16)>,
+    /// The control word passed to the drive last.
+    last_control: u16,
+    /// The jog control word kept while the jog runs (jog mutant).
+    kept_jog: Option<u16>,
 }
 
 fn control_bit(drive: &Drive<'_>, name: &str) -> u16 {
@@ -101,6 +132,9 @@ impl Mutant<'static> {
             drive: suite.reference().clone(),
             kind,
             armed: None,
+            last_stamp: None,
+            last_control: 0,
+            kept_jog: None,
         }
     }
 }
@@ -115,6 +149,69 @@ impl<'s> Mutant<'s> {
 
     fn number(data: &[u8]) -> i64 {
         data.iter().fold(0i64, |a, b| (a << 8) | i64::from(*b))
+    }
+
+    /// A signed value, most significant octet first.
+    fn signed(data: &[u8]) -> i64 {
+        let first = data.first().map_or(0, |b| i64::from(*b as i8));
+        data.iter()
+            .skip(1)
+            .fold(first, |a, b| (a << 8) | i64::from(*b))
+    }
+
+    /// The control-word deviations: bit 10 forced, bit 4 dropped beside bit 5, a jog word
+    /// kept, a target in a safety margin moved to the limit.
+    fn adjust_control(&mut self, out: &mut Output) {
+        let release = control_bit(&self.drive, "Release");
+        let keys = control_bit(&self.drive, "Release jog operation with keys");
+        let (word, target) = match out {
+            Output::ControlTarget {
+                control_word,
+                target,
+            }
+            | Output::SpeedControlTarget {
+                control_word,
+                target,
+                ..
+            } => (control_word, target),
+            Output::TimeStamp { .. } => return,
+        };
+        match self.kind {
+            Kind::ReadjustBitIgnored if *word & release != 0 => {
+                *word |= control_bit(&self.drive, "Readjustment");
+            }
+            Kind::JogKeysWithRelease if *word & (release | keys) == release | keys => {
+                *word &= !release;
+            }
+            Kind::JogKeptOnRelease => {
+                let jog = self.last_control & keys != 0 && self.last_control & release == 0;
+                let running =
+                    self.drive.status_word() & status_bit(&self.drive, "Drive is running") != 0;
+                if jog && running && *word & release != 0 && *word & keys == 0 {
+                    self.kept_jog = Some(self.last_control);
+                }
+                if let Some(kept) = self.kept_jog {
+                    *word = kept;
+                }
+            }
+            Kind::MarginTargetToLimit => {
+                let (end, upper, lower) = (
+                    int(&self.drive, "128"),
+                    int(&self.drive, "129"),
+                    int(&self.drive, "130"),
+                );
+                let margin = end - upper;
+                let t = i64::from(*target);
+                let transferred = *word & control_bit(&self.drive, "Transfer target values") != 0;
+                if transferred && t > upper && t <= end {
+                    *target = i32::try_from(upper).unwrap();
+                } else if transferred && t < lower && t >= lower - margin {
+                    *target = i32::try_from(lower).unwrap();
+                }
+            }
+            _ => {}
+        }
+        self.last_control = *word;
     }
 }
 
@@ -131,6 +228,21 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                 repeated = true;
             }
         }
+        if let Output::TimeStamp { control, stamp } = &mut out {
+            let inactive = Stamp::inactive(rules.timestamp());
+            let now_seen = (control.0, stamp.0);
+            if self.kind == Kind::InactiveStampRuns
+                && stamp.0 == inactive.0
+                && control.0 == POSITIONING_CODE
+                && self
+                    .last_stamp
+                    .is_some_and(|(c, st)| st == inactive.0 && c != control.0)
+            {
+                *stamp = Stamp(0);
+            }
+            self.last_stamp = Some(now_seen);
+        }
+        self.adjust_control(&mut out);
         let mask = match self.kind {
             Kind::NoLoopIgnored => control_bit(&self.drive, "Run without loop"),
             Kind::ClearErrorsIgnored => control_bit(&self.drive, "Clear error bits"),
@@ -179,6 +291,12 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
             }
         }
         let mut input = last.unwrap_or_else(|| self.drive.input());
+        if input.status & status_bit(&self.drive, "Drive is running") == 0 && input.rpm == 0 {
+            self.kept_jog = None;
+        }
+        if self.kind == Kind::StatusBytesSwapped {
+            input.status = input.status.swap_bytes();
+        }
         if self.kind == Kind::TemperatureBitMissing {
             input.status &= !status_bit(&self.drive, "Temperature exceeded");
         }
@@ -222,6 +340,17 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                 }
                 Kind::ReadOnlyWritable if param.is_some_and(|p| p.access == Access::R) => {
                     return Reply::Written;
+                }
+                Kind::LimitIntoMarginAccepted
+                    if param.is_some_and(|p| p.id == "129" || p.id == "130") =>
+                {
+                    let end = int(&self.drive, "128");
+                    let v = Self::signed(data);
+                    let upper = v > end - MARGIN && v <= end;
+                    let lower = v >= end - ENCODER && v < end - ENCODER + MARGIN;
+                    if upper || lower {
+                        return Reply::Written;
+                    }
                 }
                 Kind::TimeoutIgnored
                     if param.is_some_and(|p| p.id == rules.protocol().timeout.timeout_param) =>
@@ -301,6 +430,31 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
 
     fn env(&mut self, now: Micros, env: Env) -> bool {
         match (self.kind, env) {
+            (Kind::ReadjustAfterAbort, Env::Displace(n)) => {
+                let aborted = self.drive.status_word()
+                    & status_bit(&self.drive, "Positioning run aborted")
+                    != 0;
+                let ok = CyclicDevice::env(&mut self.drive, now, env);
+                let enabled =
+                    control_bit(&self.drive, "Release") | control_bit(&self.drive, "Readjustment");
+                let forwards = int(&self.drive, "134") == 0;
+                let against = (n < 0) == forwards;
+                if ok && aborted && against && self.last_control & enabled == enabled {
+                    let target = i32::try_from(self.drive.target()).unwrap();
+                    let transfer = control_bit(&self.drive, "Transfer target values");
+                    for control_word in
+                        [self.last_control & !transfer, self.last_control | transfer]
+                    {
+                        let out = Output::ControlTarget {
+                            control_word,
+                            target,
+                        };
+                        self.drive.handle_output(now, &out).unwrap();
+                    }
+                    while self.drive.poll_input().is_some() {}
+                }
+                ok
+            }
             (Kind::JogKeysIgnored, Env::Keys { .. }) => true,
             (Kind::SavedLostOnPowerCycle, Env::PowerCycle) => {
                 let ok = CyclicDevice::env(&mut self.drive, now, env);
@@ -371,7 +525,12 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::RangeIgnored,
             name: "range ignored",
             must_fail: &["psx3xx/isdu/write/135/above-max", "psx3xx/timeout/reserved"],
-            breaks: &["PSX-DP-ERR-004", "PSX-ISDU-*-RANGE", "PSX-TIMEOUT-007"],
+            breaks: &[
+                "PSX-DP-ERR-004",
+                "PSX-ISDU-*-RANGE",
+                "PSX-TIMEOUT-007",
+                "PSX-POS-001",
+            ],
         },
         Case {
             kind: Kind::FormatSwitchImmediate,
@@ -449,6 +608,67 @@ pub fn mutants() -> Vec<Case> {
             name: "control bit 14 (clear error bits) ignored",
             must_fail: &["psx3xx/status/release-withdrawn"],
             breaks: &["PSX-CTL-14-1", "PSX-STS-5-RESET-2"],
+        },
+    ]
+}
+
+/// Mutants of behaviour only the suite's hand-written cases reach (a run aborted and the
+/// shaft turned, a jog switched to a positioning release, a target in a safety margin, a
+/// format switch before a control code): the fuzzer's bounded random runs do not.
+pub fn suite_mutants() -> Vec<Case> {
+    vec![
+        Case {
+            kind: Kind::InactiveStampRuns,
+            name: "stamp 0x3FFF executed as a time stamp",
+            must_fail: &["psx3xx/timestamp/inactive-value"],
+            breaks: &["PSX-TS-002"],
+        },
+        Case {
+            kind: Kind::ReadjustAfterAbort,
+            name: "readjustment after a run stopped by the release",
+            must_fail: &["psx3xx/position/readjust-after-abort"],
+            breaks: &["PSX-ADJ-008"],
+        },
+        Case {
+            kind: Kind::ReadjustBitIgnored,
+            name: "readjustment without control bit 10",
+            must_fail: &["psx3xx/position/readjust-disabled"],
+            breaks: &["PSX-ADJ-009"],
+        },
+        Case {
+            kind: Kind::JogKeysWithRelease,
+            name: "jog keys active beside the release",
+            must_fail: &["psx3xx/position/jog-with-release"],
+            breaks: &["PSX-JOG-003"],
+        },
+        Case {
+            kind: Kind::JogKeptOnRelease,
+            name: "jog run kept when the release replaces the jog release",
+            must_fail: &["psx3xx/position/jog-release-switched"],
+            breaks: &["PSX-JOG-004"],
+        },
+        Case {
+            kind: Kind::MarginTargetToLimit,
+            name: "target in a safety margin run to the limit",
+            must_fail: &["psx3xx/position/safety-margin"],
+            breaks: &["PSX-MAP-001", "PSX-STS-12-SET-1"],
+        },
+        Case {
+            kind: Kind::LimitIntoMarginAccepted,
+            name: "limits into the safety margins acknowledged",
+            must_fail: &["psx3xx/position/measuring-range"],
+            breaks: &[
+                "PSX-POS-001",
+                "PSX-ISDU-129-RANGE",
+                "PSX-ISDU-130-RANGE",
+                "PSX-DP-ERR-004",
+            ],
+        },
+        Case {
+            kind: Kind::StatusBytesSwapped,
+            name: "status word least significant byte first",
+            must_fail: &["psx3xx/status/byte-order"],
+            breaks: &["PSX-PD-008"],
         },
     ]
 }

@@ -3,7 +3,7 @@
 //! values and quantities the steps name from the spec and the reference drive (manual
 //! 3.3–3.5, 4, 5).
 
-use super::{step, Gen, PsxCase, StepDef, EXACT, MOTION, RUN_MAX};
+use super::{step, Gen, OpenPoint, PsxCase, StepDef, EXACT, MOTION, RUN_MAX};
 use crate::case::Role;
 use drivespec_psx3xx::scenario::{Action, Control, Judge, Quantity, ScenarioStep, Setup, StepRole};
 use drivespec_psx3xx::step::Step;
@@ -59,11 +59,30 @@ impl Gen<'_, '_> {
                 Judge::Exact => (EXACT, false),
                 Judge::Motion => (MOTION, true),
             };
+            let open = typed.setup.open.as_ref().map(|o| OpenPoint {
+                requirement: o.requirement.clone(),
+                text: o.text.clone(),
+                bits: o
+                    .bits
+                    .iter()
+                    .filter_map(|b| 1u16.checked_shl(u32::from(*b)))
+                    .fold(0, |w, b| w | b),
+                movement: false,
+            });
+            if let Some(o) = &open {
+                if self.family.requirement(&o.requirement).is_none() {
+                    self.errors.push(format!(
+                        "{}: scenario {:?}: unknown requirement {} of the open point",
+                        record.file, record.id, o.requirement
+                    ));
+                }
+            }
             let case = PsxCase {
                 start: self.idle(self.rules.default_format()),
                 steps,
                 tol,
                 plot,
+                open,
             };
             self.push(
                 format!("psx3xx/{}", record.id),

@@ -73,6 +73,7 @@ impl Gen<'_, '_> {
                         steps,
                         tol: MOTION,
                         plot: true,
+                        open: None,
                     },
                 );
             }
