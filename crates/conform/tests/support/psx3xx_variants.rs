@@ -24,6 +24,10 @@ pub enum Kind {
     /// A save to EEPROM takes this many µs; ISDU 193 reads 1 until it is finished (3.1: "≠ 0
     /// → Save is still running").
     SaveTime(Micros),
+    /// Status bit 11 set whenever the shaft is turned at standstill by more than the
+    /// positioning window, also after a run stopped by withdrawing the release (3.4 bit 11
+    /// names no completed run), until the next run.
+    DisplacedAfterAbort,
 }
 
 /// The reference drive with the freedom `kind` taken.
@@ -36,6 +40,8 @@ pub struct Variant<'s> {
     pending: VecDeque<(Micros, Vec<u8>)>,
     /// When the save in progress is finished.
     saving_until: Option<Micros>,
+    /// The shaft was turned beyond the window after an aborted run (bit 11 shown).
+    displaced: bool,
 }
 
 impl Variant<'static> {
@@ -48,6 +54,7 @@ impl Variant<'static> {
             applied: None,
             pending: VecDeque::new(),
             saving_until: None,
+            displaced: false,
         }
     }
 }
@@ -83,7 +90,14 @@ impl<'s> CyclicDevice<'s> for Variant<'s> {
         while let Some((_, i)) = self.drive.poll_input() {
             last = Some(i);
         }
-        let input = last.unwrap_or_else(|| self.drive.input());
+        let mut input = last.unwrap_or_else(|| self.drive.input());
+        if self.displaced {
+            if input.status & status_bit(&self.drive, RUNNING) != 0 {
+                self.displaced = false;
+            } else {
+                input.status |= status_bit(&self.drive, DISPLACED);
+            }
+        }
         input.to_bytes(&rules, order).map_err(|e| e.to_string())
     }
 
@@ -125,6 +139,17 @@ impl<'s> CyclicDevice<'s> for Variant<'s> {
     fn env(&mut self, now: Micros, env: Env) -> bool {
         if matches!(env, Env::PowerCycle) {
             self.saving_until = None;
+            self.displaced = false;
+        }
+        if let (Kind::DisplacedAfterAbort, Env::Displace(n)) = (self.kind, env) {
+            let status = self.drive.status_word();
+            let window = match self.drive.value(WINDOW) {
+                drivespec_psx3xx::isdu::Value::Int(w) => w,
+                _ => 0,
+            };
+            let standing = status & status_bit(&self.drive, RUNNING) == 0;
+            let aborted = status & status_bit(&self.drive, ABORTED) != 0;
+            self.displaced |= standing && aborted && n.abs() > window;
         }
         CyclicDevice::env(&mut self.drive, now, env)
     }
@@ -136,6 +161,18 @@ impl<'s> CyclicDevice<'s> for Variant<'s> {
 
 /// ISDU 193: delivery state and save command (3.1).
 const DELIVERY_STATE: u16 = 193;
+/// ISDU 131: the positioning window (3.1).
+const WINDOW: &str = "131";
+/// Status bits by their names in the spec (3.4).
+const RUNNING: &str = "Drive is running";
+const ABORTED: &str = "Positioning run aborted";
+const DISPLACED: &str = "Manual displacement";
+
+/// The mask of the status bit `name` (3.4).
+fn status_bit(drive: &Drive<'_>, name: &str) -> u16 {
+    let bits = drive.rules().status_bits().unwrap();
+    1 << bits.bits.iter().find(|x| x.name == name).unwrap().bit
+}
 
 impl Variant<'_> {
     /// Whether `req` writes a command that saves to EEPROM (3.1 ISDU 2 = 161, ISDU 193).
@@ -187,5 +224,9 @@ pub fn variants() -> Vec<(&'static str, Kind)> {
         ("start latency 30 ms", Kind::StartLatency(30_000)),
         ("identification of its own", Kind::OwnValues),
         ("a save takes 1.5 s", Kind::SaveTime(1_500_000)),
+        (
+            "bit 11 also after an aborted run",
+            Kind::DisplacedAfterAbort,
+        ),
     ]
 }
