@@ -31,3 +31,34 @@ fn every_psx3xx_legal_variant_passes() {
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+#[test]
+fn bit_11_after_an_aborted_run_is_reported_as_the_open_point() {
+    use drivespec_conform::case::{Finding, Outcome};
+    use drivespec_conform::suite::Session;
+    use support::psx3xx_variants::Kind;
+    let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+    let index = suite
+        .cases()
+        .iter()
+        .position(|c| c.id == "psx3xx/position/readjust-after-abort")
+        .unwrap();
+    let bits = |kind: Option<Kind>| {
+        let server = match kind {
+            Some(k) => Server::new("variant", "psx3xx", Box::new(Variant::new(k))),
+            None => suite.server(),
+        };
+        let mut session = suite.session(Box::new(LocalPeer::new("dut", server)));
+        let run = session.run(index);
+        assert_eq!(run.outcome, Outcome::Pass);
+        match run.findings.as_slice() {
+            [Finding::Open { requirement, text }] => {
+                assert_eq!(requirement, "PSX-STS-11-SET-1");
+                text.clone()
+            }
+            other => panic!("{other:?}"),
+        }
+    };
+    assert!(bits(None).ends_with("at 0x0000"));
+    assert!(bits(Some(Kind::DisplacedAfterAbort)).ends_with("at 0x0800"));
+}
