@@ -553,6 +553,7 @@ impl Drive {
         if self.motor.profile.is_some() {
             return;
         }
+        self.adopt_written_positions();
         match kind {
             PositionCommand::ClearIncrement => self.mem_set(ml.increment, 0),
             PositionCommand::Zero => {
@@ -569,6 +570,15 @@ impl Drive {
         if kind != PositionCommand::ClearIncrement {
             self.write_motor();
         }
+    }
+
+    /// HPD-PAR-059: while a profile executes in mode 9 its parameters Pr51 and Pr52 cannot
+    /// be changed (Pr64:65 can).
+    pub(super) fn locked_by_profile(&self, slot: Slot) -> bool {
+        let ml = &self.layout.motor;
+        self.motor.profile.is_some()
+            && self.mode() == names::MODE_POSITIONER
+            && (slot == ml.p51 || slot == ml.p52)
     }
 
     /// The motor at rest, as after power-up.
