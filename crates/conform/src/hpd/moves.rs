@@ -335,6 +335,13 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
                 slack: SPEED_SLACK_RPM,
             },
         ),
+        // The watch lasts the written-down bound: reaching the speed in it is the ramp time.
+        check(
+            "HPD-FORMULA-016",
+            Envelope::Reaches {
+                within: within(0, target - SPEED_SLACK_RPM, target + SPEED_SLACK_RPM),
+            },
+        ),
         check(
             "HPD-MODE-8-001",
             Envelope::Reaches {
@@ -348,14 +355,6 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
             },
         ),
     ];
-    if forward {
-        checks.push(check(
-            "HPD-FORMULA-016",
-            Envelope::Reaches {
-                within: within(0, target - SPEED_SLACK_RPM, target + SPEED_SLACK_RPM),
-            },
-        ));
-    }
     checks.extend(speed_bits(m));
     watch(
         g,
@@ -443,7 +442,7 @@ fn stop_ramp(g: &mut Gen, m: &Motion) {
             JOG_RPM + SPEED_SLACK_RPM,
         )],
         vec![check(
-            "HPD-MODE-8-001",
+            "HPD-FORMULA-016",
             Envelope::Reaches {
                 within: within(0, JOG_RPM - SPEED_SLACK_RPM, JOG_RPM + SPEED_SLACK_RPM),
             },
@@ -526,6 +525,7 @@ fn reference_select(g: &mut Gen, m: &Motion) {
                     within: within(0, -SPEED_SLACK_RPM, INTERNAL_RPM + SPEED_SLACK_RPM),
                 },
             ),
+            check("HPD-FORMULA-016", Envelope::Reaches { within: speed }),
             check("HPD-MODE-002", Envelope::Reaches { within: speed }),
             check(
                 "HPD-FORMULA-007",
@@ -555,12 +555,20 @@ fn reference_select(g: &mut Gen, m: &Motion) {
             JOG_RPM - SPEED_SLACK_RPM,
             JOG_RPM + SPEED_SLACK_RPM,
         )],
-        vec![check(
-            "HPD-MODE-002",
-            Envelope::Reaches {
-                within: within(0, JOG_RPM - SPEED_SLACK_RPM, JOG_RPM + SPEED_SLACK_RPM),
-            },
-        )],
+        vec![
+            check(
+                "HPD-FORMULA-016",
+                Envelope::Reaches {
+                    within: within(0, JOG_RPM - SPEED_SLACK_RPM, JOG_RPM + SPEED_SLACK_RPM),
+                },
+            ),
+            check(
+                "HPD-MODE-002",
+                Envelope::Reaches {
+                    within: within(0, JOG_RPM - SPEED_SLACK_RPM, JOG_RPM + SPEED_SLACK_RPM),
+                },
+            ),
+        ],
     );
     cleanup(g, &mut cb, m, &values);
     g.push(cb);
@@ -653,18 +661,6 @@ fn positioning(g: &mut Gen, m: &Motion, reverse: bool) {
                 },
             ),
             check(
-                "HPD-MODE-9-PROFILE-BUSY",
-                Envelope::BusyWhileMoving {
-                    flags: 1,
-                    bit: 7,
-                    probe: 0,
-                    from: 0,
-                    to,
-                    rpm: top + SPEED_SLACK_RPM,
-                    window,
-                },
-            ),
-            check(
                 "HPD-MODE-9-001",
                 Envelope::Ends {
                     within: within(0, to - window, to + window),
@@ -674,6 +670,18 @@ fn positioning(g: &mut Gen, m: &Motion, reverse: bool) {
                 "HPD-MODE-POSITION",
                 Envelope::Ends {
                     within: within(3, to - window, to + window),
+                },
+            ),
+            check(
+                "HPD-MODE-9-PROFILE-BUSY",
+                Envelope::BusyWhileMoving {
+                    flags: 1,
+                    bit: 7,
+                    probe: 0,
+                    from: 0,
+                    to,
+                    rpm: top + SPEED_SLACK_RPM,
+                    window,
                 },
             ),
         ],
