@@ -247,6 +247,25 @@ pub enum Envelope {
         /// Backwards motion allowed (resolution).
         slack: i64,
     },
+    /// Between two rounds the position read `position` moves as far as the speed read
+    /// `speed` (rpm) lets it in the time between: no farther than `top_rpm` and no less than
+    /// the lower of the two speeds allow, at `steps_per_rev` steps a revolution, ± `slack`
+    /// percent and `slack_steps` (a speed that rises and falls once between two reads is
+    /// nowhere below the lower of them).
+    Travel {
+        /// Index of the position's read.
+        position: usize,
+        /// Index of the speed's read.
+        speed: usize,
+        /// Position steps per revolution.
+        steps_per_rev: i64,
+        /// The highest speed of the motion (rpm).
+        top_rpm: i64,
+        /// Relative slack (percent).
+        slack: i64,
+        /// Absolute slack (steps).
+        slack_steps: i64,
+    },
     /// Bit `bit` of read `flags` is 1 while read `probe` lies in one of `ranges` and 0 while
     /// it lies in none; judged where every read of `probe` from `lag_us` before the bit's
     /// read to the first one after it agrees (the drive updates the bit in its own time slot).

@@ -63,6 +63,13 @@ pub(crate) fn allowed(env: &Envelope) -> String {
             "the value never {} by more than {slack}",
             if *rising { "falls" } else { "rises" }
         ),
+        Envelope::Travel {
+            steps_per_rev,
+            top_rpm,
+            ..
+        } => format!(
+            "the position moves as the speed lets it: {steps_per_rev} steps a revolution, at most {top_rpm} rpm"
+        ),
         Envelope::BitFollows { bit, ranges, .. } => {
             format!("bit {bit} = 1 exactly while the value lies in {ranges:?}")
         }
@@ -183,6 +190,50 @@ pub(crate) fn judge(env: &Envelope, rounds: &[Round]) -> Result<String, String> 
                 });
             }
             Ok(format!("{} value(s) in one direction", v.len()))
+        }
+        Envelope::Travel {
+            position,
+            speed,
+            steps_per_rev,
+            top_rpm,
+            slack,
+            slack_steps,
+        } => {
+            let steps = |rpm: f64, us: Micros| rpm * *steps_per_rev as f64 * us as f64 / 60e6;
+            let mut judged = 0usize;
+            for w in rounds.windows(2) {
+                let [a, b] = w else { continue };
+                let (Some(pa), Some(pb), Some(va), Some(vb)) = (
+                    a.get(*position),
+                    b.get(*position),
+                    a.get(*speed),
+                    b.get(*speed),
+                ) else {
+                    continue;
+                };
+                let moved = (pb.value - pa.value).abs() as f64;
+                let outer = steps(*top_rpm as f64, pb.came.saturating_sub(pa.sent));
+                let low = va.value.abs().min(vb.value.abs()) as f64;
+                // The speed reads lie after the position reads of their rounds.
+                let inner = steps(low, pb.sent.saturating_sub(va.came));
+                let most = outer * (100 + slack) as f64 / 100.0 + *slack_steps as f64;
+                let least = inner * (100 - slack) as f64 / 100.0 - *slack_steps as f64;
+                if moved > most || moved < least {
+                    return Err(format!(
+                        "the position moved {moved:.0} steps from {} at {} to {} at {}, with the speed at {} and {} rpm: {least:.0}..={most:.0} steps expected",
+                        pa.value,
+                        ms(pa.sent, start),
+                        pb.value,
+                        ms(pb.came, start),
+                        va.value,
+                        vb.value
+                    ));
+                }
+                judged += 1;
+            }
+            Ok(format!(
+                "{judged} step(s) of the position consistent with the speed"
+            ))
         }
         Envelope::BitFollows {
             flags,

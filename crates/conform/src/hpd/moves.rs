@@ -33,6 +33,11 @@ const HOLD_US: u64 = 150_000;
 /// Time allowed on top of the speed-window slot for a status bit to follow the speed (µs):
 /// the reads around the bit's read take line time.
 const BIT_LAG_SLACK_US: u64 = 20_000;
+/// Travel between two reads may differ from what the speed reads allow by this much
+/// (percent): the speed is read a few ms after the position, on a ramp.
+const TRAVEL_SLACK_PERCENT: i64 = 10;
+/// ... and by this many steps on top (position resolution and one slot of the drive).
+const TRAVEL_SLACK_STEPS: i64 = 50;
 /// Position steps per revolution (manual 3.6.4).
 const STEPS_PER_REV: i64 = 4096;
 
@@ -52,6 +57,8 @@ const OVERSPEED: i64 = 300;
 const WINDOW: (i64, i64) = (700, 400);
 /// The internal reference Pr5 (rpm) of the reference-selection case.
 const INTERNAL_RPM: i64 = 250;
+/// Spindle orientation speed Pr50 (rpm).
+const ORIENT_RPM: i64 = 200;
 /// Positioning profile: Pr51 (ms per 1000 rpm), Pr52 (rpm), revolutions.
 const PROFILE: (i64, i64, i64) = (200, 600, 5);
 
@@ -70,6 +77,9 @@ pub(crate) fn generate(g: &mut Gen) {
     locked_while_busy(g, &m);
     clear_increment(g, &m);
     wiring_test(g, &m);
+    feed_forward_defaults(g, &m);
+    resets(g, &m);
+    orientation(g, &m);
 }
 
 /// The slots and reads the motion cases use.
@@ -99,10 +109,12 @@ impl Motion {
                 signed: p.data_type.signed() || size == Some(4),
             })
         };
-        let slots = [5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 56, 57, 64]
-            .iter()
-            .map(|n| Some((*n, g.slot_of(&format!("Pr{n}"))?)))
-            .collect::<Option<Vec<_>>>()?;
+        let slots = [
+            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 54, 56, 57, 64,
+        ]
+        .iter()
+        .map(|n| Some((*n, g.slot_of(&format!("Pr{n}"))?)))
+        .collect::<Option<Vec<_>>>()?;
         let lag = g
             .protocol
             .task_slots
@@ -661,6 +673,17 @@ fn positioning(g: &mut Gen, m: &Motion, reverse: bool) {
                 },
             ),
             check(
+                "HPD-FORMULA-017",
+                Envelope::Travel {
+                    position: 0,
+                    speed: 2,
+                    steps_per_rev: STEPS_PER_REV,
+                    top_rpm: top + SPEED_SLACK_RPM,
+                    slack: TRAVEL_SLACK_PERCENT,
+                    slack_steps: TRAVEL_SLACK_STEPS,
+                },
+            ),
+            check(
                 "HPD-MODE-9-001",
                 Envelope::Ends {
                     within: within(0, to - window, to + window),
@@ -837,5 +860,200 @@ fn wiring_test(g: &mut Gen, m: &Motion) {
     }
     g.restore(&mut cb, m.mode, "Pr31");
     g.restore_pb99(&mut cb);
+    g.push(cb);
+}
+
+/// HPD-MODE-9-007, HPD-MODE-10-008: b99.11 gives b70.6 its mode default: 0 in modes 9 and
+/// 11, 1 in mode 10.
+fn feed_forward_defaults(g: &mut Gen, m: &Motion) {
+    let (Some(defaults), Some(ff)) = (g.bit_ref(names::MODE_DEFAULTS), g.bit_ref("b70.6")) else {
+        return;
+    };
+    for (mode, requirement, default) in [
+        (9, "HPD-MODE-9-007", false),
+        (11, "HPD-MODE-9-007", false),
+        (10, "HPD-MODE-10-008", true),
+    ] {
+        let mut cb = CaseB::new(
+            format!("hpd/motion/mode-{mode}/feed-forward-default"),
+            format!(
+                "mode {mode}: after b70.6 = {} the mode defaults (b99.11) give b70.6 = {}",
+                u8::from(!default),
+                u8::from(default)
+            ),
+            &[],
+        );
+        setup(g, &mut cb, m, mode, &[]);
+        g.bit(&mut cb, Role::Setup, &ff, !default);
+        g.bit(&mut cb, Role::Setup, &defaults, true);
+        g.read(
+            &mut cb,
+            Role::Check,
+            m.pb70,
+            Compare::Mask(bit_value(m.pb70, ff.at)),
+            "Pb70 (b70.6)",
+        );
+        if let Some(step) = cb.steps.last_mut() {
+            step.requirements.insert(0, requirement.to_owned());
+        }
+        g.restore(&mut cb, m.pb70, "Pb70");
+        g.restore(&mut cb, m.mode, "Pr31");
+        g.restore_pb99(&mut cb);
+        g.push(cb);
+    }
+}
+
+/// HPD-MODE-11-004, HPD-MODE-10-007: the reset types act on the positions written by the
+/// master (mode 11: type 3 then type 1; mode 10: type 1 refused while the axis is locked).
+fn resets(g: &mut Gen, m: &Motion) {
+    let position = Slot {
+        addr: m.position.par,
+        size: 4,
+    };
+    let reference = Slot {
+        addr: m.reference.par,
+        size: 4,
+    };
+    let (motor_at, reference_at) = (5_000, 7_000);
+    let read = |g: &mut Gen, cb: &mut CaseB, slot: Slot, what: &str, req: &str| {
+        g.read(cb, Role::Check, slot, Compare::Exact, what);
+        if let Some(step) = cb.steps.last_mut() {
+            step.requirements.insert(0, req.to_owned());
+        }
+    };
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-11/resets",
+        format!(
+            "mode 11 with Pr62:63 = {motor_at} and Pr60:61 = {reference_at}: reset type 3 (b70.12) sets the reference to the motor position, reset type 1 (b70.10) zeroes both"
+        ),
+        &[],
+    );
+    setup(g, &mut cb, m, 11, &[]);
+    g.write(&mut cb, Role::Setup, position, motor_at, "Pr62:63");
+    g.write(&mut cb, Role::Setup, reference, reference_at, "Pr60:61");
+    command(g, &mut cb, Role::Check, "b70.12");
+    read(g, &mut cb, reference, "Pr60:61", "HPD-MODE-11-004");
+    command(g, &mut cb, Role::Check, "b70.10");
+    read(g, &mut cb, position, "Pr62:63", "HPD-MODE-11-004");
+    read(g, &mut cb, reference, "Pr60:61", "HPD-MODE-11-004");
+    g.restore(&mut cb, m.pb70, "Pb70");
+    g.restore(&mut cb, m.mode, "Pr31");
+    g.restore_pb99(&mut cb);
+    g.push(cb);
+
+    let (Some(lock), Some(reset)) = (g.bit_ref("b70.8"), g.bit_ref("b70.10")) else {
+        return;
+    };
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-10/reset-only-released",
+        format!(
+            "mode 10 with Pr62:63 = {motor_at}: reset type 1 (b70.10) is not executed while the axis is locked (b70.8 = 1), and is once it is released"
+        ),
+        &[],
+    );
+    setup(g, &mut cb, m, 10, &[]);
+    g.write(&mut cb, Role::Setup, position, motor_at, "Pr62:63");
+    g.bit(&mut cb, Role::Setup, &lock, true);
+    g.bit(&mut cb, Role::Check, &reset, true);
+    read(g, &mut cb, position, "Pr62:63", "HPD-MODE-10-007");
+    g.bit(&mut cb, Role::Setup, &lock, false);
+    g.bit(&mut cb, Role::Check, &reset, true);
+    read(g, &mut cb, position, "Pr62:63", "HPD-MODE-10-007");
+    g.restore(&mut cb, m.pb70, "Pb70");
+    g.restore(&mut cb, m.mode, "Pr31");
+    g.restore_pb99(&mut cb);
+    g.push(cb);
+}
+
+/// HPD-MODE-12-001, HPD-MODE-12-SERVO-ERROR: with b40.2 = 1 mode 12 turns at no more than
+/// Pr50 and stops with the shaft (Pr28) within Pr56 of Pr54; b70.5 is then 0.
+fn orientation(g: &mut Gen, m: &Motion) {
+    let (Some(shaft), Some(servo)) = (g.slot_of("Pr28"), g.bit_ref("b70.5")) else {
+        return;
+    };
+    let (top, ramp, at, window) = (ORIENT_RPM, RAMP_DOWN, STEPS_PER_REV / 2, 100);
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-12/orientation",
+        format!(
+            "mode 12: b40.2 = 1 turns the spindle at no more than Pr50 = {top} rpm and stops it with Pr28 within Pr56 = {window} of Pr54 = {at}; b70.5 (set by the master before) is 0 with the loop closed"
+        ),
+        &[],
+    );
+    let values = [
+        (m.pr(50), top, "Pr50"),
+        (m.pr(52), ramp, "Pr52"),
+        (m.pr(54), at, "Pr54"),
+        (m.pr(56), window, "Pr56"),
+    ];
+    setup(g, &mut cb, m, 12, &values);
+    g.bit(&mut cb, Role::Setup, &servo, true);
+    let pb40 = pb40_with(g, m, &[names::RESERVED_REFERENCE]);
+    g.write(&mut cb, Role::Check, m.pb40, pb40, "Pb40 (b40.2 = 1)");
+    let probe = Probe {
+        par: shaft.addr,
+        lun: shaft.size,
+        signed: false,
+    };
+    // At most two revolutions at Pr50 plus the ramps.
+    let ideal_us = u64::try_from(2 * 60_000_000 / top + top * ramp).unwrap_or(0);
+    let speed = within(0, top - SPEED_SLACK_RPM, top + SPEED_SLACK_RPM);
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr0 until it reaches Pr50 = {top} rpm"),
+        vec![m.speed],
+        time_bound(top, ramp),
+        vec![speed],
+        vec![check(
+            "HPD-MODE-12-001",
+            Envelope::Reaches { within: speed },
+        )],
+    );
+    if let Some(step) = cb.steps.last_mut() {
+        if let Action::Watch { hold_us, .. } = &mut step.action {
+            *hold_us = 0;
+        }
+    }
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr0, Pr28 and Pb70 until the spindle stands at {at}"),
+        vec![m.speed, probe, m.flags70],
+        ideal_us * TIME_FACTOR_PERCENT / 100 + TIME_EXTRA_US + HOLD_US,
+        vec![
+            within(0, 0, 0),
+            within(1, at - window, at + window),
+            bit_is(2, 5, 0),
+        ],
+        vec![
+            check(
+                "HPD-MODE-12-001",
+                Envelope::Bounded {
+                    within: within(0, -SPEED_SLACK_RPM, top + SPEED_SLACK_RPM),
+                },
+            ),
+            check(
+                "HPD-MODE-12-001",
+                Envelope::Ends {
+                    within: within(1, at - window, at + window),
+                },
+            ),
+            check(
+                "HPD-MODE-12-001",
+                Envelope::Ends {
+                    within: within(0, 0, 0),
+                },
+            ),
+            check(
+                "HPD-MODE-12-SERVO-ERROR",
+                Envelope::Ends {
+                    within: bit_is(2, 5, 0),
+                },
+            ),
+        ],
+    );
+    cleanup(g, &mut cb, m, &values);
     g.push(cb);
 }

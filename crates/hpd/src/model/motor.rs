@@ -65,6 +65,7 @@ pub(super) struct MotorLayout {
     p50: Slot,
     p51: Slot,
     p52: Slot,
+    p54: Slot,
     p56: Slot,
     p57: Slot,
     reference: Slot,
@@ -114,6 +115,7 @@ impl MotorLayout {
             p50: slot(50)?,
             p51: slot(51)?,
             p52: slot(52)?,
+            p54: slot(54)?,
             p56: slot(56)?,
             p57: slot(57)?,
             reference: double(60)?,
@@ -148,6 +150,10 @@ struct Profile {
     done: f64,
     /// Profile speed now (rpm, ≥ 0).
     speed: f64,
+    /// Acceleration and deceleration (rpm/µs), fixed at the start.
+    accel: f64,
+    /// Steady speed (rpm), fixed at the start.
+    top: f64,
 }
 
 /// The motor's own state beyond the parameters.
@@ -167,6 +173,8 @@ pub(super) struct Motor {
     /// The speed reference while b40.3 freezes it.
     frozen: Option<f64>,
     profile: Option<Profile>,
+    /// Mode 12 has oriented the spindle since b40.2 last rose.
+    oriented: bool,
     /// b70.8 as last seen (a profile starts on its rise).
     start_seen: bool,
     /// When a jog or speed request was first seen (start latency), by its sign.
@@ -202,6 +210,7 @@ impl Drive {
             || self.request() != 0.0
             || self.start_pending()
             || self.wiring_pending()
+            || self.orientation_pending()
     }
 
     /// A rise of b70.8 in mode 9 not yet taken.
@@ -227,7 +236,7 @@ impl Drive {
                     _ => 0.0,
                 }
             }
-            names::MODE_POSITIONER => self
+            names::MODE_POSITIONER | names::MODE_ORIENTATION => self
                 .motor
                 .profile
                 .as_ref()
@@ -271,6 +280,11 @@ impl Drive {
     /// Keeps Pr6, Pr7 and b41.0–b41.3 in line with the motor (manual 3.3).
     pub(super) fn refresh_motor_status(&mut self) {
         let ml = self.layout.motor.clone();
+        if self.mode() != names::MODE_ORIENTATION
+            || !self.working.bit(bit(ml.pb40, names::B40_RESERVED))
+        {
+            self.motor.oriented = false;
+        }
         let main = self.main_reference();
         self.mem_set(ml.main, main);
         self.motor.main_from_internal = self.internal_reference();
@@ -314,12 +328,17 @@ impl Drive {
         self.wiring_test();
         self.start_profile(t);
         let mode = self.mode();
-        // DECISION: leaving mode 9 abandons a profile.
-        if mode != names::MODE_POSITIONER {
+        let b40 = |d: &Drive, y| d.working.bit(bit(ml.pb40, y));
+        let orienting = mode == names::MODE_ORIENTATION && b40(self, names::B40_RESERVED);
+        // DECISION: leaving mode 9, or mode 12 and its b40.2, abandons a profile.
+        if mode != names::MODE_POSITIONER && !orienting {
             self.motor.profile = None;
         }
-        let b40 = |d: &Drive, y| d.working.bit(bit(ml.pb40, y));
-        let positioning = mode == names::MODE_POSITIONER && self.motor.profile.is_some();
+        if !orienting {
+            self.motor.oriented = false;
+        }
+        self.start_orientation(t);
+        let positioning = self.motor.profile.is_some();
         if positioning {
             self.profile_step(t, dt);
         } else {
@@ -342,6 +361,12 @@ impl Drive {
             let moved = (old + new) / 2.0 * dt * STEPS_PER_REV / US_PER_MIN;
             self.motor.position += moved;
             self.motor.reference = self.motor.position;
+        }
+        // HPD-MODE-12-SERVO-ERROR: in mode 12 b70.5 is 0 while the position error (none for
+        // the ideal loop) is within Pr56.
+        if mode == names::MODE_ORIENTATION {
+            self.working
+                .set_bit(bit(ml.pb70, names::B70_SERVO_ERROR), false);
         }
         self.write_motor();
         self.refresh_motor_status();
@@ -462,10 +487,14 @@ impl Drive {
         } else {
             1.0
         };
+        let accel = self.ramp_of(ml.p51);
+        let top = (self.mem_i(ml.p52).abs() as f64).max(1.0);
         self.motor.profile = Some(Profile {
             start_at: t.saturating_add(ml.style.start_latency_us),
             from: self.motor.reference,
             distance: dir * steps as f64,
+            accel,
+            top,
             ..Profile::default()
         });
         // HPD-MODE-9-PROFILE-BUSY.
@@ -483,11 +512,7 @@ impl Drive {
             self.motor.profile = Some(p);
             return;
         }
-        let accel_units = self.working.get(ml.p51.addr, ml.p51.size).max(1);
-        let accel = RPM_PER_RAMP / (f64::from(accel_units) * US_PER_RAMP_UNIT)
-            * f64::from(ml.style.ramp_percent)
-            / 100.0;
-        let top = (self.mem_i(ml.p52).abs() as f64).max(1.0);
+        let (accel, top) = (p.accel, p.top);
         let total = p.distance.abs();
         let left = total - p.done;
         let per_rpm_us = STEPS_PER_REV / US_PER_MIN;
@@ -514,14 +539,57 @@ impl Drive {
         };
         self.motor.position = self.motor.reference;
         self.motor.speed = dir * new;
-        if finished {
+        if finished && self.mode() == names::MODE_POSITIONER {
             // HPD-MODE-9-PROFILE-BUSY, HPD-MODE-9-START-CLEAR: both bits drop at the end.
             self.working.set_bit(bit(ml.pb70, names::B70_BUSY), false);
             self.working.set_bit(bit(ml.pb70, names::B70_START), false);
             self.motor.start_seen = false;
-        } else {
+        }
+        if !finished {
             self.motor.profile = Some(p);
         }
+    }
+
+    /// The acceleration a ramp parameter in ms per 1000 rpm allows (rpm/µs), as the motion
+    /// style uses it.
+    fn ramp_of(&self, slot: Slot) -> f64 {
+        let units = self.working.get(slot.addr, slot.size).max(1);
+        RPM_PER_RAMP / (f64::from(units) * US_PER_RAMP_UNIT)
+            * f64::from(self.layout.motor.style.ramp_percent)
+            / 100.0
+    }
+
+    /// Mode 12 waits for its orientation: b40.2 = 1 and not oriented yet.
+    fn orientation_pending(&self) -> bool {
+        let ml = &self.layout.motor;
+        self.mode() == names::MODE_ORIENTATION
+            && self.working.bit(bit(ml.pb40, names::B40_RESERVED))
+            && !self.motor.oriented
+    }
+
+    /// HPD-MODE-12-001: with b40.2 = 1 mode 12 reaches Pr50 on the ramp Pr52, turns at that
+    /// speed to the shaft position Pr54 and closes the position loop there. DECISION: it
+    /// turns forward, at least one revolution, so that the speed is reached first.
+    fn start_orientation(&mut self, t: Micros) {
+        if !self.orientation_pending() || self.motor.profile.is_some() {
+            return;
+        }
+        let ml = self.layout.motor.clone();
+        self.motor.oriented = true;
+        let rev = STEPS_PER_REV as i64;
+        let shaft = self.motor.position.floor() as i64;
+        let to = self.mem_i(ml.p54).rem_euclid(rev);
+        let distance = (to - shaft).rem_euclid(rev) + rev;
+        let accel = self.ramp_of(ml.p52);
+        let top = (self.mem_i(ml.p50).abs() as f64).max(1.0);
+        self.motor.profile = Some(Profile {
+            start_at: t.saturating_add(ml.style.start_latency_us),
+            from: shaft as f64,
+            distance: distance as f64,
+            accel,
+            top,
+            ..Profile::default()
+        });
     }
 
     /// HPD-MODE-8-004: b70.3 in mode 8 runs the wiring test; with b40.9 = 1 (or the drive
@@ -551,6 +619,10 @@ impl Drive {
     pub(super) fn position_command(&mut self, kind: PositionCommand) {
         let ml = self.layout.motor.clone();
         if self.motor.profile.is_some() {
+            return;
+        }
+        // HPD-MODE-10-007: in mode 10 the reset needs the axis released (b70.8 = 0).
+        if self.mode() == names::MODE_LOCKING && self.working.bit(bit(ml.pb70, names::B70_START)) {
             return;
         }
         self.adopt_written_positions();

@@ -35,6 +35,10 @@ pub(super) const TASK_SLOW_MODE: &str = "slow operating mode";
 pub(super) const MODE_MAINTENANCE: u32 = 8;
 /// Operating mode 9, positioner (manual 3.6.4).
 pub(super) const MODE_POSITIONER: u32 = 9;
+/// Operating mode 10, digital locking (manual 3.6.5).
+pub(super) const MODE_LOCKING: u32 = 10;
+/// Operating mode 12, spindle orientation (manual 3.6.7).
+pub(super) const MODE_ORIENTATION: u32 = 12;
 /// The modes with a position loop, Pr60:61 and Pr62:63 (manual 3.6.4–3.6.6).
 pub(super) const POSITION_MODES: [u32; 3] = [9, 10, 11];
 /// b40.2: the operating mode's reference Pr6 drives the speed loop (manual 3.3).
@@ -63,9 +67,11 @@ pub(super) const B70_JOG_REVERSE: u8 = 2;
 pub(super) const B70_WIRING_TEST: u8 = 3;
 /// b70.4 in mode 9: direction of the next profile (manual 3.6.4).
 pub(super) const B70_DIRECTION: u8 = 4;
+/// b70.5 in modes 9–12: servo error (manual 3.6.4–3.6.7).
+pub(super) const B70_SERVO_ERROR: u8 = 5;
 /// b70.7 in mode 9: profile in execution (manual 3.6.4).
 pub(super) const B70_BUSY: u8 = 7;
-/// b70.8 in mode 9: start profile (manual 3.6.4).
+/// b70.8 in mode 9: start profile; in modes 10 and 11: axis lock (manual 3.6.4–3.6.6).
 pub(super) const B70_START: u8 = 8;
 /// Wiring test code 1: b40.9 = 1 or the drive disabled through the hardware (manual 3.6.3).
 pub(super) const WIRING_DISABLED: i64 = 1;
