@@ -586,9 +586,11 @@ fn reference_select(g: &mut Gen, m: &Motion) {
     g.push(cb);
 }
 
-/// Sets `bit` with a bit change as a set-up step, if it is a bit of the spec.
+/// Sets command bit `name` with a bit change, cleared first: a drive whose command bits stay
+/// 1 until the master clears them (the `latched` reading of HPD-ERRATUM-012) sees a rise.
 fn command(g: &mut Gen, cb: &mut CaseB, role: Role, name: &str) {
     if let Some(b) = g.bit_ref(name) {
+        g.bit(cb, Role::Setup, &b, false);
         g.bit(cb, role, &b, true);
     }
 }
@@ -866,7 +868,7 @@ fn wiring_test(g: &mut Gen, m: &Motion) {
 /// HPD-MODE-9-007, HPD-MODE-10-008: b99.11 gives b70.6 its mode default: 0 in modes 9 and
 /// 11, 1 in mode 10.
 fn feed_forward_defaults(g: &mut Gen, m: &Motion) {
-    let (Some(defaults), Some(ff)) = (g.bit_ref(names::MODE_DEFAULTS), g.bit_ref("b70.6")) else {
+    let Some(ff) = g.bit_ref("b70.6") else {
         return;
     };
     for (mode, requirement, default) in [
@@ -885,7 +887,7 @@ fn feed_forward_defaults(g: &mut Gen, m: &Motion) {
         );
         setup(g, &mut cb, m, mode, &[]);
         g.bit(&mut cb, Role::Setup, &ff, !default);
-        g.bit(&mut cb, Role::Setup, &defaults, true);
+        command(g, &mut cb, Role::Setup, names::MODE_DEFAULTS);
         g.read(
             &mut cb,
             Role::Check,
@@ -941,7 +943,7 @@ fn resets(g: &mut Gen, m: &Motion) {
     g.restore_pb99(&mut cb);
     g.push(cb);
 
-    let (Some(lock), Some(reset)) = (g.bit_ref("b70.8"), g.bit_ref("b70.10")) else {
+    let Some(lock) = g.bit_ref("b70.8") else {
         return;
     };
     let mut cb = CaseB::new(
@@ -954,10 +956,10 @@ fn resets(g: &mut Gen, m: &Motion) {
     setup(g, &mut cb, m, 10, &[]);
     g.write(&mut cb, Role::Setup, position, motor_at, "Pr62:63");
     g.bit(&mut cb, Role::Setup, &lock, true);
-    g.bit(&mut cb, Role::Check, &reset, true);
+    command(g, &mut cb, Role::Check, "b70.10");
     read(g, &mut cb, position, "Pr62:63", "HPD-MODE-10-007");
     g.bit(&mut cb, Role::Setup, &lock, false);
-    g.bit(&mut cb, Role::Check, &reset, true);
+    command(g, &mut cb, Role::Check, "b70.10");
     read(g, &mut cb, position, "Pr62:63", "HPD-MODE-10-007");
     g.restore(&mut cb, m.pb70, "Pb70");
     g.restore(&mut cb, m.mode, "Pr31");
@@ -968,14 +970,14 @@ fn resets(g: &mut Gen, m: &Motion) {
 /// HPD-MODE-12-001, HPD-MODE-12-SERVO-ERROR: with b40.2 = 1 mode 12 turns at no more than
 /// Pr50 and stops with the shaft (Pr28) within Pr56 of Pr54; b70.5 is then 0.
 fn orientation(g: &mut Gen, m: &Motion) {
-    let (Some(shaft), Some(servo)) = (g.slot_of("Pr28"), g.bit_ref("b70.5")) else {
+    let Some(shaft) = g.slot_of("Pr28") else {
         return;
     };
     let (top, ramp, at, window) = (ORIENT_RPM, RAMP_DOWN, STEPS_PER_REV / 2, 100);
     let mut cb = CaseB::new(
         "hpd/motion/mode-12/orientation",
         format!(
-            "mode 12: b40.2 = 1 turns the spindle at no more than Pr50 = {top} rpm and stops it with Pr28 within Pr56 = {window} of Pr54 = {at}; b70.5 (set by the master before) is 0 with the loop closed"
+            "mode 12: b40.2 = 1 turns the spindle up to Pr50 = {top} rpm, never faster, and stops it with Pr28 within Pr56 = {window} of Pr54 = {at}; b70.5 is 0 with the loop closed there"
         ),
         &[],
     );
@@ -986,7 +988,6 @@ fn orientation(g: &mut Gen, m: &Motion) {
         (m.pr(56), window, "Pr56"),
     ];
     setup(g, &mut cb, m, 12, &values);
-    g.bit(&mut cb, Role::Setup, &servo, true);
     let pb40 = pb40_with(g, m, &[names::RESERVED_REFERENCE]);
     g.write(&mut cb, Role::Check, m.pb40, pb40, "Pb40 (b40.2 = 1)");
     let probe = Probe {

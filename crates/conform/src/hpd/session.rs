@@ -1079,9 +1079,13 @@ impl HpdSession<'_, '_> {
                         until,
                         hold_us: *hold_us,
                     };
-                    let rounds = self.watch(&watch, &mut rec);
-                    match rounds {
-                        Ok(rounds) => Ok(Some(
+                    match self.watch(&watch, &mut rec) {
+                        Ok((_, Some(rule))) => {
+                            broke = Some(rule.to_owned());
+                            let why = rec.note.clone().unwrap_or_default();
+                            Ok(Some((false, why)))
+                        }
+                        Ok((rounds, None)) => Ok(Some(
                             self.judge_watch(&watch, checks, &rounds, &mut rec, &mut broke),
                         )),
                         Err(e) => Err(e),
@@ -1255,6 +1259,14 @@ impl HpdSession<'_, '_> {
     }
 }
 
+/// The rounds of a watch, with the frame rule a read without a response broke (which ends
+/// the watch), or a transport error.
+type WatchResult = Result<(Vec<Round>, Option<&'static str>), (LinkError, Vec<Chunk>)>;
+
+/// The rule a read without a response breaks when its bytes break no frame rule (manual 4.1:
+/// a read is answered with the parameter's value).
+const NO_RESPONSE: &str = "HPD-FRAME-010";
+
 /// A watch step's reads and when it ends (manual 3.3, 3.6).
 struct Watch<'w> {
     addr: u8,
@@ -1269,11 +1281,7 @@ impl HpdSession<'_, '_> {
     /// Reads the watch's parameters from the device round after round until its end; the
     /// reference only goes along in time, then runs on until the same `until` holds for it
     /// (its motion ended too) so that the steps after the watch find it in the same state.
-    fn watch(
-        &mut self,
-        w: &Watch<'_>,
-        rec: &mut Record,
-    ) -> Result<Vec<Round>, (LinkError, Vec<Chunk>)> {
+    fn watch(&mut self, w: &Watch<'_>, rec: &mut Record) -> WatchResult {
         let rules = self.suite.rules.clone();
         let requests: Vec<(Probe, Vec<u8>)> = w
             .reads
@@ -1327,6 +1335,29 @@ impl HpdSession<'_, '_> {
                         });
                     }
                     _ => {
+                        let bytes = concat(&got);
+                        let raw = self.oracle.memory().get(probe.par, probe.lun);
+                        let expected = Data::from_value(i64::from(raw), probe.lun)
+                            .and_then(|data| {
+                                Message::Response {
+                                    addr: w.addr,
+                                    par: probe.par,
+                                    data,
+                                }
+                                .to_bytes(&rules)
+                                .ok()
+                            })
+                            .unwrap_or_default();
+                        rec.expected = Some(self.answer(
+                            &[Chunk {
+                                at: sent,
+                                bytes: expected,
+                            }],
+                            sent,
+                            None,
+                        ));
+                        rec.got = Some(self.answer(&got, sent, None));
+                        let broken = frame_rule_broken(&rules, &bytes).unwrap_or(NO_RESPONSE);
                         rec.note = Some(format!(
                             "no response to the read of {} byte(s) at {:#04x}: {}",
                             probe.lun,
@@ -1338,7 +1369,7 @@ impl HpdSession<'_, '_> {
                             }
                         ));
                         rounds.push(round);
-                        return Ok(rounds);
+                        return Ok((rounds, Some(broken)));
                     }
                 }
             }
@@ -1367,7 +1398,7 @@ impl HpdSession<'_, '_> {
         }
         let _ = self.oracle_output(o, t);
         self.journal.listen(o);
-        Ok(rounds)
+        Ok((rounds, None))
     }
 
     /// Whether the watch's `until` holds for the reference's values now.
@@ -1406,29 +1437,16 @@ impl HpdSession<'_, '_> {
             .map_or(first, |s| s.came);
         let mut seen = Vec::new();
         let mut allowed = Vec::new();
-        let complete = rounds.last().is_some_and(|r| r.len() == w.reads.len());
         for c in checks {
             allowed.push(format!(
                 "{}: {}",
                 c.requirement,
                 motion::allowed(&c.envelope)
             ));
-            let verdict = if complete {
-                motion::judge(&c.envelope, rounds)
-            } else {
-                Err(rec
-                    .note
-                    .clone()
-                    .unwrap_or_else(|| "no rounds read".to_owned()))
-            };
-            match verdict {
+            match motion::judge(&c.envelope, rounds) {
                 Ok(text) => seen.push(format!("{}: {text}", c.requirement)),
                 Err(why) => {
-                    *broke = Some(if complete {
-                        c.requirement.clone()
-                    } else {
-                        "HPD-FRAME-010".to_owned()
-                    });
+                    *broke = Some(c.requirement.clone());
                     rec.expected = Some(text_answer(allowed.join("; ")));
                     rec.got = Some(text_answer(why.clone()));
                     return (false, format!("{}: {why}", c.requirement));

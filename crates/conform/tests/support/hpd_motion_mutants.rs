@@ -41,6 +41,18 @@ pub enum Kind {
     IncrementKept,
     /// The wiring test ends with code 0 although b40.9 = 1.
     WiringNoError,
+    /// The mode defaults b99.11 leave Pb70 as it is.
+    DefaultsKeepFlags,
+    /// Reset types 1 and 3 do nothing in mode 11.
+    ResetsIgnoredInMode11,
+    /// Reset type 1 runs in mode 10 with the axis locked.
+    ResetWhileLocked,
+    /// Pr62:63 counts 1000 steps a revolution in mode 9.
+    ThousandStepsPerRev,
+    /// The spindle stops 300 steps past Pr54.
+    OrientationOvershoot,
+    /// b70.5 reads 1 in mode 12 with b40.2 = 1, whatever the position error.
+    ServoErrorStuck,
 }
 
 /// A drive with a deviation of its motion.
@@ -168,9 +180,47 @@ impl MotionMutant {
                     }
                 }
             }
+            Kind::ResetsIgnoredInMode11
+                if self.mode() == 11 && (self.sets_b70(bytes, 10) || self.sets_b70(bytes, 12)) =>
+            {
+                let kept: Vec<(Target<'static>, i64)> = ["Pr60:61", "Pr62:63"]
+                    .iter()
+                    .map(|id| (target(id), self.value(id)))
+                    .collect();
+                self.inner.handle_rx(now, bytes);
+                for (t, v) in kept {
+                    let _ = self.inner.set_value(now, &t, v);
+                }
+            }
+            Kind::ResetWhileLocked if self.mode() == 10 && self.sets_b70(bytes, 10) => {
+                let lock = target("b70.8");
+                let kept = self.value("b70.8");
+                let _ = self.inner.set_value(now, &lock, 0);
+                self.inner.handle_rx(now, bytes);
+                let _ = self.inner.set_value(now, &lock, kept);
+            }
+            Kind::DefaultsKeepFlags
+                if [9, 10, 11].contains(&self.mode()) && self.sets_b99_11(bytes) =>
+            {
+                let flags = target("Pb70");
+                let kept = self.value("Pb70");
+                self.inner.handle_rx(now, bytes);
+                let _ = self.inner.set_value(now, &flags, kept);
+            }
             _ => self.inner.handle_rx(now, bytes),
         }
         self.watch_wiring(now);
+    }
+
+    /// Whether `bytes` set b99.11 with a bit change.
+    fn sets_b99_11(&self, bytes: &[u8]) -> bool {
+        let Ok(Message::BitChange {
+            par, mask, value, ..
+        }) = parse(&self.rules, bytes)
+        else {
+            return false;
+        };
+        par == addr("Pb99") + 1 && mask & 0x08 == 0 && value & 0x08 != 0
     }
 
     /// `WiringNoError`: when b70.3 drops in mode 8, Pr56 shows 0.
@@ -207,6 +257,17 @@ impl MotionMutant {
                 Some(i64::from(data.unsigned() & !(1 << 7)))
             }
             Kind::NoReference if mode == 9 && par == addr("Pr60") && data.len() == 4 => Some(0),
+            Kind::ThousandStepsPerRev if mode == 9 && par == addr("Pr62") && data.len() == 4 => {
+                Some(signed(&data) * 1000 / 4096)
+            }
+            Kind::ServoErrorStuck
+                if mode == 12 && self.value("b40.2") == 1 && par == addr("Pb70") =>
+            {
+                Some(i64::from(data.unsigned() | 1 << 5))
+            }
+            Kind::OrientationOvershoot if mode == 12 && par == addr("Pr28") => {
+                Some((signed(&data) + 300).rem_euclid(4096))
+            }
             _ => None,
         };
         match new.and_then(|v| Data::from_value(v, data.len())) {
@@ -270,6 +331,7 @@ pub fn motion_mutants() -> Vec<Case> {
         "HPD-PAR-027",
         "HPD-FORMULA-016",
         "HPD-MODE-9-001",
+        "HPD-MODE-12-001",
     ];
     let mut out = vec![
         Case {
@@ -379,6 +441,55 @@ pub fn motion_mutants() -> Vec<Case> {
             first: "HPD-MODE-8-004",
             breaks: &["HPD-MODE-8-004"],
             must_fail: &["hpd/motion/mode-8/wiring-test-enabled"],
+        },
+        Case {
+            name: "b99.11 keeps b70.6 in mode 9",
+            kind: Kind::DefaultsKeepFlags,
+            first: "HPD-MODE-9-007",
+            breaks: &["HPD-MODE-9-007", "HPD-MODE-10-008"],
+            must_fail: &["hpd/motion/mode-9/feed-forward-default"],
+        },
+        Case {
+            name: "b99.11 keeps b70.6 in mode 10",
+            kind: Kind::DefaultsKeepFlags,
+            first: "HPD-MODE-10-008",
+            breaks: &["HPD-MODE-9-007", "HPD-MODE-10-008"],
+            must_fail: &["hpd/motion/mode-10/feed-forward-default"],
+        },
+        Case {
+            name: "reset types ignored in mode 11",
+            kind: Kind::ResetsIgnoredInMode11,
+            first: "HPD-MODE-11-004",
+            breaks: &["HPD-MODE-11-004"],
+            must_fail: &["hpd/motion/mode-11/resets"],
+        },
+        Case {
+            name: "reset type 1 with the axis locked in mode 10",
+            kind: Kind::ResetWhileLocked,
+            first: "HPD-MODE-10-007",
+            breaks: &["HPD-MODE-10-007"],
+            must_fail: &["hpd/motion/mode-10/reset-only-released"],
+        },
+        Case {
+            name: "1000 position steps a revolution",
+            kind: Kind::ThousandStepsPerRev,
+            first: "HPD-FORMULA-017",
+            breaks: &["HPD-FORMULA-017", "HPD-MODE-9-001", "HPD-MODE-POSITION"],
+            must_fail: &["hpd/motion/mode-9/profile-forward"],
+        },
+        Case {
+            name: "spindle stops 300 steps past Pr54",
+            kind: Kind::OrientationOvershoot,
+            first: "HPD-MODE-12-001",
+            breaks: &["HPD-MODE-12-001"],
+            must_fail: &["hpd/motion/mode-12/orientation"],
+        },
+        Case {
+            name: "b70.5 reads 1 in mode 12 with the loop closed",
+            kind: Kind::ServoErrorStuck,
+            first: "HPD-MODE-12-SERVO-ERROR",
+            breaks: &["HPD-MODE-12-SERVO-ERROR"],
+            must_fail: &["hpd/motion/mode-12/orientation"],
         },
     ];
     for (bit, name, first) in [
