@@ -16,8 +16,8 @@ use crate::case::Role;
 use drivespec_hpd::memory::Slot;
 use drivespec_hpd::step::{Check, Envelope, Probe, Within};
 
-/// Speed resolution plus one slot of the drive (rpm): 1 rpm of Pr0 and a 2.048 ms slot of the
-/// steepest ramp these cases use (about 2 rpm), rounded up.
+/// Speed tolerance (rpm): the 1 rpm resolution of Pr0 and the small overshoot and ripple of a
+/// real speed loop around its reference.
 const SPEED_SLACK_RPM: i64 = 5;
 /// A ramp may be this much steeper than its parameter (percent): the measured speed of a real
 /// drive follows the ramped reference with the small lag and overshoot of its speed loop.
@@ -36,7 +36,8 @@ const BIT_LAG_SLACK_US: u64 = 20_000;
 /// Travel between two reads may differ from what the speed reads allow by this much
 /// (percent): the speed is read a few ms after the position, on a ramp.
 const TRAVEL_SLACK_PERCENT: i64 = 10;
-/// ... and by this many steps on top (position resolution and one slot of the drive).
+/// ... and by this many steps on top of one slot's travel (position resolution, the loop's
+/// following error).
 const TRAVEL_SLACK_STEPS: i64 = 50;
 /// Position steps per revolution (manual 3.6.4).
 const STEPS_PER_REV: i64 = 4096;
@@ -96,6 +97,9 @@ struct Motion {
     flags70: Probe,
     slots: Vec<(u8, Slot)>,
     bit_lag_us: u64,
+    /// The drive's slow operating-mode slot (µs): a drive may change its speed and position
+    /// in steps of one slot.
+    slot_us: u64,
 }
 
 impl Motion {
@@ -120,6 +124,11 @@ impl Motion {
             .task_slots
             .iter()
             .find(|s| s.tasks.iter().any(|t| t == names::TASK_SPEED_WINDOWS))?;
+        let slot = g
+            .protocol
+            .task_slots
+            .iter()
+            .find(|s| s.tasks.iter().any(|t| t == names::TASK_SLOW_MODE))?;
         Some(Motion {
             mode: g.slot_of(names::OPERATING_MODE)?,
             pb40: g.slot_of("Pb40")?,
@@ -133,7 +142,25 @@ impl Motion {
             flags70: probe("Pb70", None)?,
             slots,
             bit_lag_us: u64::from(lag.period_us) + BIT_LAG_SLACK_US,
+            slot_us: u64::from(slot.period_us),
         })
+    }
+
+    /// The slack of a speed change of at most `per_s` a second: one slot's change at that
+    /// rate, plus the speed resolution.
+    fn slope_slack(&self, per_s: i64) -> i64 {
+        let slot = i64::try_from(self.slot_us).unwrap_or(i64::MAX);
+        per_s.saturating_mul(slot).div_euclid(1_000_000) + 1 + SPEED_SLACK_RPM
+    }
+
+    /// The slack of a travel at up to `rpm`: one slot's travel, plus the position resolution.
+    fn travel_slack(&self, rpm: i64) -> i64 {
+        let slot = i64::try_from(self.slot_us).unwrap_or(i64::MAX);
+        rpm.saturating_mul(STEPS_PER_REV)
+            .saturating_mul(slot)
+            .div_euclid(60_000_000)
+            + 1
+            + TRAVEL_SLACK_STEPS
     }
 
     fn pr(&self, n: u8) -> Slot {
@@ -344,7 +371,7 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
             Envelope::Slope {
                 probe: 0,
                 per_s: ramp_per_s(up_raw),
-                slack: SPEED_SLACK_RPM,
+                slack: m.slope_slack(ramp_per_s(up_raw)),
             },
         ),
         // The watch lasts the written-down bound: reaching the speed in it is the ramp time.
@@ -395,7 +422,7 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
             Envelope::Slope {
                 probe: 0,
                 per_s: ramp_per_s(down_raw),
-                slack: SPEED_SLACK_RPM,
+                slack: m.slope_slack(ramp_per_s(down_raw)),
             },
         ),
         check(
@@ -475,7 +502,7 @@ fn stop_ramp(g: &mut Gen, m: &Motion) {
                 Envelope::Slope {
                     probe: 0,
                     per_s: ramp_per_s(RAMP_STOP),
-                    slack: SPEED_SLACK_RPM,
+                    slack: m.slope_slack(ramp_per_s(RAMP_STOP)),
                 },
             ),
             check(
@@ -671,7 +698,7 @@ fn positioning(g: &mut Gen, m: &Motion, reverse: bool) {
                 Envelope::Slope {
                     probe: 2,
                     per_s: ramp_per_s(accel),
-                    slack: SPEED_SLACK_RPM,
+                    slack: m.slope_slack(ramp_per_s(accel)),
                 },
             ),
             check(
@@ -682,7 +709,7 @@ fn positioning(g: &mut Gen, m: &Motion, reverse: bool) {
                     steps_per_rev: STEPS_PER_REV,
                     top_rpm: top + SPEED_SLACK_RPM,
                     slack: TRAVEL_SLACK_PERCENT,
-                    slack_steps: TRAVEL_SLACK_STEPS,
+                    slack_steps: m.travel_slack(top + SPEED_SLACK_RPM),
                 },
             ),
             check(

@@ -53,3 +53,5 @@ pub const SOFTWARE_ENABLE: &str = "b40.9";
 pub const DIGITAL_REFERENCE: &str = "b40.12";
 /// The appendix F task that updates the speed windows (`protocol.task_slots`).
 pub const TASK_SPEED_WINDOWS: &str = "speed windows manager";
+/// The appendix F task the operating modes run in (`protocol.task_slots`).
+pub const TASK_SLOW_MODE: &str = "slow operating mode";

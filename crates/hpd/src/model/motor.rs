@@ -516,13 +516,17 @@ impl Drive {
         let total = p.distance.abs();
         let left = total - p.done;
         let per_rpm_us = STEPS_PER_REV / US_PER_MIN;
-        let braking = p.speed * p.speed / (2.0 * accel) * per_rpm_us;
         let old = p.speed;
-        let mut new = if braking >= left {
-            (old - accel * dt).max(accel * dt)
-        } else {
-            (old + accel * dt).min(top)
-        };
+        // The highest speed from which the distance left after this slot (at about the
+        // present speed) can still be braked.
+        let rest = (left - old * dt * per_rpm_us).max(0.0);
+        let brakeable = (2.0 * accel * rest / per_rpm_us).sqrt();
+        // At least one slot's speed change, so that the profile ends.
+        let mut new = (old + accel * dt)
+            .min(top)
+            .min(brakeable)
+            .max(old - accel * dt)
+            .max(accel * dt);
         let mut moved = (old + new) / 2.0 * dt * per_rpm_us;
         let finished = moved >= left;
         if finished {
