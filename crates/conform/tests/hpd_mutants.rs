@@ -164,3 +164,61 @@ fn clean_up_writes_back_the_devices_own_value() {
     // CMD 5 to drive 0 (0xA0), LUN 2, PAR 0x46, data 20 = 14 00.
     assert_eq!(back, ["7E A0 02 46 14 00 FC"]);
 }
+
+/// Every motion mutant (`support::hpd_motion_mutants`) fails the cases named for it, each
+/// citing the requirement the deviation breaks first, and fails no case that cites none of
+/// the requirements it breaks.
+#[test]
+fn every_motion_mutant_fails_citing_its_requirement_first() {
+    use support::hpd_motion_mutants::{motion_mutants, MotionMutant};
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let mut problems = Vec::new();
+    let mut report = Vec::new();
+    let all = motion_mutants();
+    for m in &all {
+        let link = SimLink::new(
+            format!("mutant: {}", m.name),
+            Box::new(MotionMutant::new(m.kind)),
+        );
+        let mut session = suite.session(Box::new(link));
+        let mut failed = Vec::new();
+        for (i, info) in suite.cases().iter().enumerate() {
+            if let Outcome::Fail(f) = session.run(i).outcome {
+                let cites: Vec<&str> = f
+                    .requirements
+                    .iter()
+                    .map(|r| r.id.as_str())
+                    .chain(info.requirements.iter().map(String::as_str))
+                    .collect();
+                if !m.breaks.iter().any(|b| cites.contains(b)) {
+                    problems.push(format!(
+                        "{}: collateral failure {} ({})",
+                        m.name, info.id, f.message
+                    ));
+                }
+                failed.push((
+                    info.id.clone(),
+                    f.requirements.first().map(|r| r.id.clone()),
+                ));
+            }
+        }
+        for want in m.must_fail {
+            match failed.iter().find(|(id, _)| id == want) {
+                None => problems.push(format!("{}: {want} did not fail", m.name)),
+                Some((_, first)) if first.as_deref() != Some(m.first) => problems.push(format!(
+                    "{}: {want} cites {first:?} first, not {}",
+                    m.name, m.first
+                )),
+                Some(_) => {}
+            }
+        }
+        report.push(format!(
+            "{:<58} first {:<26} fails {:>3} case(s)",
+            m.name,
+            m.first,
+            failed.len()
+        ));
+    }
+    println!("HPD motion mutants:\n{}", report.join("\n"));
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}

@@ -147,7 +147,7 @@ fn conform_passes(dut: &Dut, cases: &[&str]) -> Summary {
 
 #[cfg(unix)]
 #[test]
-fn serial_over_a_pty_passes_frames_params_vectors_commands_and_every_baud_code() {
+fn serial_over_a_pty_passes_frames_params_vectors_commands_motion_and_every_baud_code() {
     let (served, path) = serve_pty(Faults::default());
     let dut = Dut::Serial { path, baud: None };
     let s = conform_passes(
@@ -159,6 +159,7 @@ fn serial_over_a_pty_passes_frames_params_vectors_commands_and_every_baud_code()
             "hpd/broadcast",
             "hpd/cmd",
             "hpd/baud",
+            "hpd/motion",
         ],
     );
     let r = &s.report;

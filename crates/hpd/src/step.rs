@@ -91,6 +91,29 @@ pub enum Step {
         /// Its length in bytes.
         lun: u8,
     },
+    /// Reads `reads` from the drive at `addr` round after round and judges the device's own
+    /// samples by `checks` (manual 3.3, 3.6: motion is judged by the properties the manual
+    /// states, never against the reference's trajectory). The watch ends `hold_us` after
+    /// every condition of `until` first held, or after `us`.
+    Watch {
+        /// Drive address.
+        addr: u8,
+        /// The parameters read in each round, in this order.
+        reads: Vec<Probe>,
+        /// Longest watch (µs).
+        us: Micros,
+        /// Shortest time from one round's start to the next (µs).
+        #[serde(default)]
+        every_us: Micros,
+        /// Conditions that end the watch (all of them, in one round).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        until: Vec<Within>,
+        /// How long the watch goes on after `until` held (µs).
+        #[serde(default)]
+        hold_us: Micros,
+        /// The properties judged, each for one requirement.
+        checks: Vec<Check>,
+    },
     /// Writes the data the case's `save` of `par` read from the device back to the drive at
     /// `addr` and to the reference (the device's own value, manual 4.1 CMD 5); nothing when
     /// no `save` read it.
@@ -118,6 +141,7 @@ impl Step {
             Step::BitRate {} => "bit-rate",
             Step::Save { .. } => "save",
             Step::Restore { .. } => "restore",
+            Step::Watch { .. } => "watch",
         }
     }
 
@@ -145,6 +169,137 @@ impl Step {
             other => other.clone(),
         }
     }
+}
+
+/// One parameter read in each round of a watch (manual 4.1 CMD 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Probe {
+    /// Serial address.
+    pub par: u8,
+    /// Length in bytes.
+    pub lun: u8,
+    /// Read as a two's-complement value.
+    #[serde(default)]
+    pub signed: bool,
+}
+
+/// A condition on one read of a round: the value (or one bit of it) within `min..=max`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Within {
+    /// Index into the watch's reads.
+    pub probe: usize,
+    /// The bit of the value tested instead of the value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bit: Option<u32>,
+    /// Lowest value.
+    pub min: i64,
+    /// Highest value.
+    pub max: i64,
+}
+
+/// A property of a watch's samples, judged for one requirement.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Check {
+    /// The requirement the property belongs to.
+    pub requirement: String,
+    /// The property.
+    pub envelope: Envelope,
+}
+
+/// What the manual lets a watched value do (manual 3.3 ramps and windows, 3.6 modes).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "is", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Envelope {
+    /// The value comes into `min..=max` in some round.
+    Reaches {
+        /// The read and the range.
+        within: Within,
+    },
+    /// Every value lies in `min..=max`.
+    Bounded {
+        /// The read and the range.
+        within: Within,
+    },
+    /// The value of the last round lies in `min..=max`.
+    Ends {
+        /// The read and the range.
+        within: Within,
+    },
+    /// From one round to the next the value changes by at most `per_s` a second of the time
+    /// between the first read's request and the second read's answer, plus `slack`.
+    Slope {
+        /// Index into the watch's reads.
+        probe: usize,
+        /// Largest change a second.
+        per_s: i64,
+        /// Change allowed on top (resolution, one slot of the drive).
+        slack: i64,
+    },
+    /// The value never moves against the direction by more than `slack`.
+    Monotonic {
+        /// Index into the watch's reads.
+        probe: usize,
+        /// Rising (true) or falling.
+        rising: bool,
+        /// Backwards motion allowed (resolution).
+        slack: i64,
+    },
+    /// Between two rounds the position read `position` moves as far as the speed read
+    /// `speed` (rpm) lets it in the time between: no farther than `top_rpm` and no less than
+    /// the lower of the two speeds allow, at `steps_per_rev` steps a revolution, ± `slack`
+    /// percent and `slack_steps` (a speed that rises and falls once between two reads is
+    /// nowhere below the lower of them).
+    Travel {
+        /// Index of the position's read.
+        position: usize,
+        /// Index of the speed's read.
+        speed: usize,
+        /// Position steps per revolution.
+        steps_per_rev: i64,
+        /// The highest speed of the motion (rpm).
+        top_rpm: i64,
+        /// Relative slack (percent).
+        slack: i64,
+        /// Absolute slack (steps).
+        slack_steps: i64,
+    },
+    /// Bit `bit` of read `flags` is 1 while read `probe` lies in one of `ranges` and 0 while
+    /// it lies in none; judged where every read of `probe` from `lag_us` before the bit's
+    /// read to the first one after it agrees (the drive updates the bit in its own time slot).
+    BitFollows {
+        /// Index of the bit parameter's read.
+        flags: usize,
+        /// The bit.
+        bit: u32,
+        /// Index of the value's read.
+        probe: usize,
+        /// Where the bit is 1.
+        ranges: Vec<(i64, i64)>,
+        /// How long the bit may lag behind the value (µs).
+        lag_us: Micros,
+    },
+    /// Bit `bit` of read `flags` is 1 while position read `probe` shows a motion from `from`
+    /// to `to` still under way (farther from `to` than `rpm` can cover before the bit's
+    /// read), and once it has read 0 after a 1 the position lies within `window` of `to`.
+    BusyWhileMoving {
+        /// Index of the bit parameter's read.
+        flags: usize,
+        /// The bit.
+        bit: u32,
+        /// Index of the position's read.
+        probe: usize,
+        /// Position at the start.
+        from: i64,
+        /// Position at the end.
+        to: i64,
+        /// The highest speed of the motion (rpm).
+        rpm: i64,
+        /// Position error allowed at the end (steps).
+        window: i64,
+    },
 }
 
 /// Bytes as spaced hex text (`7E 80 01`); any form `drivespec_spec::hex::parse_hex` reads.

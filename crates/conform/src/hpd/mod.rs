@@ -14,10 +14,13 @@
 //! | `cmd` | command bits: self-clearing, preconditions (b99.7, b99.6, b99.13, b40.2), saves across power-up |
 //! | `baud` | every Pr26 code: re-initialisation, bit rate, time-out, answer delay |
 //! | `vector` | the spec's `hpd-frame` vectors, at their drive address |
+//! | `motion` | the motor turned by jog, the speed reference and the mode 9 profile, judged by envelopes; the wiring test |
 
 mod behaviour;
 pub mod cases;
 pub mod frame;
+mod motion;
+mod moves;
 pub mod names;
 mod params;
 mod readings;
@@ -116,6 +119,7 @@ impl<'s> HpdSuite<'s> {
         frame::generate(&mut g);
         params::generate(&mut g);
         behaviour::generate(&mut g);
+        moves::generate(&mut g);
         if !g.errors.is_empty() {
             return Err(GenError::Cases(g.errors).into());
         }

@@ -43,3 +43,15 @@ pub const TRIGGER_TEST_FINISHED: &str = "wiring-test-finished";
 /// A delivery value the manual prints two ways (3.3 Pr15 default 20, 3.2 "±20 rpm",
 /// HPD-ERRATUM-005): a read at the start shows one of them.
 pub const TWO_WAY_DEFAULT: &str = "Pr15";
+/// Stop function (manual 3.3 b40.6).
+pub const STOP: &str = "b40.6";
+/// Absolute speed window (manual 3.3 b40.7).
+pub const ABSOLUTE_WINDOW: &str = "b40.7";
+/// Software enable (manual 3.3 b40.9).
+pub const SOFTWARE_ENABLE: &str = "b40.9";
+/// Digital reference, Pr7 = Pr5 with b40.13 = 0 (manual 3.3 b40.12).
+pub const DIGITAL_REFERENCE: &str = "b40.12";
+/// The appendix F task that updates the speed windows (`protocol.task_slots`).
+pub const TASK_SPEED_WINDOWS: &str = "speed windows manager";
+/// The appendix F task the operating modes run in (`protocol.task_slots`).
+pub const TASK_SLOW_MODE: &str = "slow operating mode";

@@ -9,6 +9,7 @@
 //! still run. On a transport that cannot reset the device, the reference is brought back in
 //! line after a failure by reading the parameters the case touched from the device.
 
+use super::motion::{self, Round, Sample};
 use super::readings::{Bases, Journal, Judge};
 use super::step::{Action, Compare, HpdCase, Step};
 use super::HpdSuite;
@@ -20,6 +21,7 @@ use crate::suite::Session;
 use drivespec_hpd::explain::explain;
 use drivespec_hpd::model::{Drive, Output};
 use drivespec_hpd::params::Target;
+use drivespec_hpd::step::{Check, Probe, Within};
 use drivespec_hpd::{Data, LineDecoder, LineEvent, Message};
 use drivespec_spec::hex::to_hex;
 use std::collections::BTreeMap;
@@ -891,6 +893,8 @@ impl HpdSession<'_, '_> {
             };
             // What the other admissible readings expected of a failing step.
             let mut also = String::new();
+            // The requirement a failing watch broke.
+            let mut broke: Option<String> = None;
             let result: StepResult = match &step.action {
                 Action::Exchange {
                     bytes,
@@ -1058,6 +1062,35 @@ impl HpdSession<'_, '_> {
                     }
                 }
                 Action::Save { addr, par, lun } => self.save(*addr, *par, *lun, &mut rec),
+                Action::Watch {
+                    addr,
+                    reads,
+                    us,
+                    every_us,
+                    until,
+                    hold_us,
+                    checks,
+                } => {
+                    let watch = Watch {
+                        addr: *addr,
+                        reads,
+                        us: *us,
+                        every_us: *every_us,
+                        until,
+                        hold_us: *hold_us,
+                    };
+                    match self.watch(&watch, &mut rec) {
+                        Ok((_, Some(rule))) => {
+                            broke = Some(rule.to_owned());
+                            let why = rec.note.clone().unwrap_or_default();
+                            Ok(Some((false, why)))
+                        }
+                        Ok((rounds, None)) => Ok(Some(
+                            self.judge_watch(&watch, checks, &rounds, &mut rec, &mut broke),
+                        )),
+                        Err(e) => Err(e),
+                    }
+                }
                 Action::Restore { addr, par, lun } => {
                     match self.saved.get(&(*par, *lun)).cloned() {
                         Some(data) => {
@@ -1131,6 +1164,21 @@ impl HpdSession<'_, '_> {
                             }
                         }
                         if !ok {
+                            let mut requirements = self.requirement_refs(
+                                &info.requirements,
+                                Some(step),
+                                &exp_bytes,
+                                &rec.got.as_ref().map_or_else(Vec::new, |a| {
+                                    drivespec_spec::hex::parse_hex(&a.hex).unwrap_or_default()
+                                }),
+                            );
+                            if let Some(r) = broke
+                                .as_deref()
+                                .and_then(|id| RequirementRef::of(suite.family(), id))
+                            {
+                                requirements.retain(|x| x.id != r.id);
+                                requirements.insert(0, r);
+                            }
                             failure = Some(Failure {
                                 step: Some(evidence.len()),
                                 message: format!("step {i} ({}): {why}", step.text),
@@ -1139,14 +1187,7 @@ impl HpdSession<'_, '_> {
                                     rec.expected.as_ref().map(show).unwrap_or_default()
                                 ),
                                 got: rec.got.as_ref().map(show).unwrap_or_default(),
-                                requirements: self.requirement_refs(
-                                    &info.requirements,
-                                    Some(step),
-                                    &exp_bytes,
-                                    &rec.got.as_ref().map_or_else(Vec::new, |a| {
-                                        drivespec_spec::hex::parse_hex(&a.hex).unwrap_or_default()
-                                    }),
-                                ),
+                                requirements,
                             });
                         }
                     } else {
@@ -1218,9 +1259,224 @@ impl HpdSession<'_, '_> {
     }
 }
 
+/// The rounds of a watch, with the frame rule a read without a response broke (which ends
+/// the watch), or a transport error.
+type WatchResult = Result<(Vec<Round>, Option<&'static str>), (LinkError, Vec<Chunk>)>;
+
+/// The rule a read without a response breaks when its bytes break no frame rule (manual 4.1:
+/// a read is answered with the parameter's value).
+const NO_RESPONSE: &str = "HPD-FRAME-010";
+
+/// A watch step's reads and when it ends (manual 3.3, 3.6).
+struct Watch<'w> {
+    addr: u8,
+    reads: &'w [Probe],
+    us: Micros,
+    every_us: Micros,
+    until: &'w [Within],
+    hold_us: Micros,
+}
+
+impl HpdSession<'_, '_> {
+    /// Reads the watch's parameters from the device round after round until its end; the
+    /// reference only goes along in time, then runs on until the same `until` holds for it
+    /// (its motion ended too) so that the steps after the watch find it in the same state.
+    fn watch(&mut self, w: &Watch<'_>, rec: &mut Record) -> WatchResult {
+        let rules = self.suite.rules.clone();
+        let requests: Vec<(Probe, Vec<u8>)> = w
+            .reads
+            .iter()
+            .filter_map(|p| {
+                let msg = Message::ReadParam {
+                    addr: w.addr,
+                    lun: p.lun,
+                    par: p.par,
+                };
+                msg.to_bytes(&rules).ok().map(|b| (*p, b))
+            })
+            .collect();
+        let start = self.link.now();
+        let deadline = start.saturating_add(w.us);
+        let mut rounds: Vec<Round> = Vec::new();
+        let mut held: Option<Micros> = None;
+        loop {
+            let r0 = self.link.now();
+            if r0 >= deadline || held.is_some_and(|h| r0 >= h.saturating_add(w.hold_us)) {
+                break;
+            }
+            let mut round = Round::new();
+            for (probe, bytes) in &requests {
+                let _ = self.drain_late();
+                let window = self.window();
+                let sent = self.link.now();
+                self.link.send(bytes).map_err(|e| (e, Vec::new()))?;
+                let mut whole = |b: &[u8]| {
+                    let from = b.iter().position(|x| *x == rules.stx).unwrap_or(b.len());
+                    matches!(
+                        drivespec_hpd::decode(
+                            &rules,
+                            b.get(from..).unwrap_or(&[]),
+                            drivespec_hpd::AckEnd::NextByte
+                        ),
+                        Ok(drivespec_hpd::Status::Complete(_))
+                    )
+                };
+                let got = self
+                    .link
+                    .recv(sent.saturating_add(window), &mut whole)
+                    .map_err(|e| (e, Vec::new()))?;
+                let came = got.last().map_or_else(|| self.link.now(), |c| c.at);
+                match response(&rules, &concat(&got)) {
+                    Some((par, data)) if par == probe.par && data.len() == probe.lun => {
+                        round.push(Sample {
+                            value: value_of(&data, probe.signed),
+                            sent,
+                            came,
+                        });
+                    }
+                    _ => {
+                        let bytes = concat(&got);
+                        let raw = self.oracle.memory().get(probe.par, probe.lun);
+                        let expected = Data::from_value(i64::from(raw), probe.lun)
+                            .and_then(|data| {
+                                Message::Response {
+                                    addr: w.addr,
+                                    par: probe.par,
+                                    data,
+                                }
+                                .to_bytes(&rules)
+                                .ok()
+                            })
+                            .unwrap_or_default();
+                        rec.expected = Some(self.answer(
+                            &[Chunk {
+                                at: sent,
+                                bytes: expected,
+                            }],
+                            sent,
+                            None,
+                        ));
+                        rec.got = Some(self.answer(&got, sent, None));
+                        let broken = frame_rule_broken(&rules, &bytes).unwrap_or(NO_RESPONSE);
+                        rec.note = Some(format!(
+                            "no response to the read of {} byte(s) at {:#04x}: {}",
+                            probe.lun,
+                            probe.par,
+                            if got.is_empty() {
+                                "silence".to_owned()
+                            } else {
+                                to_hex(&concat(&got))
+                            }
+                        ));
+                        rounds.push(round);
+                        return Ok((rounds, Some(broken)));
+                    }
+                }
+            }
+            let t = self.link.now();
+            let o = self.oracle_now(t);
+            self.oracle.advance(o);
+            let _ = self.oracle_output(o, t);
+            if held.is_none()
+                && !w.until.is_empty()
+                && w.until.iter().all(|c| motion::holds(c, &round))
+            {
+                held = Some(self.link.now());
+            }
+            rounds.push(round);
+            let next = r0.saturating_add(w.every_us);
+            if next > self.link.now() {
+                let _ = self.link.recv(next, &mut |_| false);
+            }
+        }
+        let t = self.link.now();
+        let mut o = self.oracle_now(t);
+        let bound = o.saturating_add(w.us);
+        while !w.until.is_empty() && o < bound && !self.oracle_holds(w) {
+            o = o.saturating_add(self.oracle.scan_period());
+            self.oracle.advance(o);
+        }
+        let _ = self.oracle_output(o, t);
+        self.journal.listen(o);
+        Ok((rounds, None))
+    }
+
+    /// Whether the watch's `until` holds for the reference's values now.
+    fn oracle_holds(&self, w: &Watch<'_>) -> bool {
+        let mem = self.oracle.memory();
+        let round: Round = w
+            .reads
+            .iter()
+            .map(|p| {
+                let raw = mem.get(p.par, p.lun);
+                let data = Data::from_value(i64::from(raw), p.lun);
+                Sample {
+                    value: data.map_or(0, |d| value_of(&d, p.signed)),
+                    sent: 0,
+                    came: 0,
+                }
+            })
+            .collect();
+        w.until.iter().all(|c| motion::holds(c, &round))
+    }
+
+    /// Judges a watch's rounds by its checks: whether all hold and why not; `broke` names the
+    /// requirement of the first check that failed.
+    fn judge_watch(
+        &self,
+        w: &Watch<'_>,
+        checks: &[Check],
+        rounds: &[Round],
+        rec: &mut Record,
+        broke: &mut Option<String>,
+    ) -> (bool, String) {
+        let first = rounds.first().and_then(|r| r.first()).map_or(0, |s| s.sent);
+        let last = rounds
+            .last()
+            .and_then(|r| r.last())
+            .map_or(first, |s| s.came);
+        let mut seen = Vec::new();
+        let mut allowed = Vec::new();
+        for c in checks {
+            allowed.push(format!(
+                "{}: {}",
+                c.requirement,
+                motion::allowed(&c.envelope)
+            ));
+            match motion::judge(&c.envelope, rounds) {
+                Ok(text) => seen.push(format!("{}: {text}", c.requirement)),
+                Err(why) => {
+                    *broke = Some(c.requirement.clone());
+                    rec.expected = Some(text_answer(allowed.join("; ")));
+                    rec.got = Some(text_answer(why.clone()));
+                    return (false, format!("{}: {why}", c.requirement));
+                }
+            }
+        }
+        rec.note = Some(format!(
+            "{} round(s) of {} read(s) over {:.1} ms",
+            rounds.len(),
+            w.reads.len(),
+            last.saturating_sub(first) as f64 / 1000.0
+        ));
+        rec.expected = Some(text_answer(allowed.join("; ")));
+        rec.got = Some(text_answer(seen.join("; ")));
+        (true, String::new())
+    }
+}
+
+/// An answer record that is a judgement in words, not bytes.
+fn text_answer(text: String) -> Answer {
+    Answer {
+        hex: String::new(),
+        text,
+        delay_us: None,
+    }
+}
+
 fn show(a: &Answer) -> String {
     if a.is_silence() {
-        "silence".to_owned()
+        a.text.clone()
     } else {
         format!("{} ({})", a.hex, a.text)
     }

@@ -4,11 +4,14 @@
 //! - the other reading of every erratum with an option (spec `[[erratum]]`, e.g. the 3.8.1
 //!   prose "b99.3 = 0 if the result is zero", or no answer to a refused write, 4.1);
 //! - a PLC whose 6.144 ms scan (3.8.1) runs at another phase from power-up;
-//! - answers sent later than the reference sends them, within the time-out (4.1).
+//! - answers sent later than the reference sends them, within the time-out (4.1);
+//! - a motor that starts later after a command and ramps more gently than its parameters
+//!   allow (3.3: the ramps are limits; 3.6.4: the profile start is "not generated on a
+//!   constant time base").
 
 use super::mutants::spec;
 use drivespec_conform::link::Micros;
-use drivespec_hpd::model::{Drive, DriveConfig, Output};
+use drivespec_hpd::model::{Drive, DriveConfig, MotionStyle, Output};
 use drivespec_sim::SimDevice;
 use drivespec_spec::{FamilyId, Readings};
 
@@ -21,6 +24,9 @@ pub enum Kind {
     ScanPhase(Micros),
     /// Every answer sent this many µs later.
     AnswerDelay(Micros),
+    /// Motion starting this many µs after its command, on this share of the steepest ramps
+    /// (percent).
+    Motion(Micros, u32),
 }
 
 /// A legal variant.
@@ -39,8 +45,14 @@ impl Variant {
                 .choose(spec().family(FamilyId::Hpd), option, reading)
                 .unwrap();
         }
-        let mut inner =
-            Drive::new(spec(), DriveConfig::commissioned(0).with_readings(readings)).unwrap();
+        let mut config = DriveConfig::commissioned(0).with_readings(readings);
+        if let Kind::Motion(start_latency_us, ramp_percent) = kind {
+            config = config.with_motion(MotionStyle {
+                start_latency_us,
+                ramp_percent,
+            });
+        }
+        let mut inner = Drive::new(spec(), config).unwrap();
         if let Kind::ScanPhase(shift) = kind {
             inner.advance(shift);
         }
@@ -71,7 +83,7 @@ impl SimDevice for Variant {
                 at: match self.kind {
                     Kind::ScanPhase(shift) => at.saturating_sub(shift),
                     Kind::AnswerDelay(d) => at + d,
-                    Kind::Reading(..) => at,
+                    Kind::Reading(..) | Kind::Motion(..) => at,
                 },
                 bytes,
             }),
@@ -116,6 +128,12 @@ pub fn variants() -> Vec<(String, Kind)> {
         out.push((
             format!("answers {delay} µs later"),
             Kind::AnswerDelay(delay),
+        ));
+    }
+    for (latency, percent) in [(10_000, 80), (30_000, 100), (3_000, 60)] {
+        out.push((
+            format!("motion {latency} µs late on {percent} % of the ramps"),
+            Kind::Motion(latency, percent),
         ));
     }
     out

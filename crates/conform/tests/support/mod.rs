@@ -10,6 +10,7 @@
     clippy::panic
 )]
 
+pub mod hpd_motion_mutants;
 pub mod hpd_variants;
 pub mod legal;
 pub mod mutants;

@@ -15,6 +15,9 @@ use drivespec_conform::hpd::frame::frame;
 use drivespec_conform::hpd::names;
 use drivespec_conform::hpd::step::{Action, Compare, Step as SuiteStep};
 use drivespec_conform::hpd::HpdSuite;
+
+/// The suite's motion cases (`hpd/motion`).
+const MOTION: &str = "hpd/motion/";
 use drivespec_conform::link::{Caps, Micros};
 use drivespec_hpd::memory::Slot;
 use drivespec_hpd::plc::{Instr, Operands};
@@ -202,9 +205,11 @@ impl<'a, 's> HpdGen<'a, 's> {
         let mut i = 0;
         while let Some((info, case)) = suite.case(i) {
             if !case.needs_power_cycle || caps.power_cycle {
+                // Motion cases wait for the motor (seconds of real time per watch) and judge
+                // the motion by its envelope, which no mutated step keeps: not seeds.
                 if info.id.starts_with("hpd/plc/vector/") {
                     plc_vectors.push(i);
-                } else if !info.id.starts_with("hpd/vector/") {
+                } else if !info.id.starts_with("hpd/vector/") && !info.id.starts_with(MOTION) {
                     seeds.push(i);
                 }
             }

@@ -100,6 +100,9 @@ impl Drive {
         if p.mode(self.mode()).is_some_and(|m| !m.writable) {
             return None;
         }
+        if self.locked_by_profile(p.slot) {
+            return None;
+        }
         // HPD-BIT-99-7, HPD-BIT-99-7-SELF: with security on, only b99.7 itself can change.
         if self.secured() {
             let sec = layout.named.security;

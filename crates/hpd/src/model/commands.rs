@@ -37,6 +37,7 @@ impl Drive {
         }
         self.service_idc(now);
         self.refresh_status();
+        self.wake_motor();
     }
 
     /// Executes one command unless its conditions forbid it (manual 3.4).
@@ -102,8 +103,9 @@ impl Drive {
                 // HPD-CMD-012: all parameters are stored.
                 self.save_parameters();
             }
-            // Commands that need what the model has not (analogue input, current sensors,
-            // motor): taken without effect.
+            CommandKind::Position(kind) => self.position_command(kind),
+            // Commands that need what the model has not (analogue input, current sensors):
+            // taken without effect.
             CommandKind::Other => {}
         }
     }
@@ -171,5 +173,6 @@ impl Drive {
             let healthy = self.alarms().active == 0;
             self.working.set_bit(b, healthy);
         }
+        self.refresh_motor_status();
     }
 }

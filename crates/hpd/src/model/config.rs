@@ -1,6 +1,7 @@
 //! How a model drive starts: factory state or commissioned for the serial line (manual 4.1,
 //! "serial line initialisation"), and the erratum readings it follows.
 
+use super::motor::MotionStyle;
 use drivespec_spec::Readings;
 
 /// The state a model drive is in when it is first powered (manual 4.1, 3.2).
@@ -35,6 +36,8 @@ pub struct DriveConfig {
     pub start: Start,
     /// The erratum readings in force, adopted ones unless chosen (e.g. HPD-ERRATUM-012, 3.4).
     pub readings: Readings,
+    /// How the motor uses the freedom the manual leaves (3.3 ramps, 3.6.4 start).
+    pub motion: MotionStyle,
 }
 
 impl DriveConfig {
@@ -43,6 +46,7 @@ impl DriveConfig {
         DriveConfig {
             start: Start::Factory,
             readings: Readings::default(),
+            motion: MotionStyle::default(),
         }
     }
 
@@ -54,6 +58,7 @@ impl DriveConfig {
                 address,
             },
             readings: Readings::default(),
+            motion: MotionStyle::default(),
         }
     }
 
@@ -65,7 +70,14 @@ impl DriveConfig {
                 address,
             },
             readings: Readings::default(),
+            motion: MotionStyle::default(),
         }
+    }
+
+    /// The same start with another motion style (manual 3.3, 3.6.4).
+    pub fn with_motion(mut self, motion: MotionStyle) -> DriveConfig {
+        self.motion = motion;
+        self
     }
 
     /// The same start with other erratum readings (spec `[[erratum]]` options).

@@ -4,6 +4,7 @@
 use super::config::{DriveConfig, Start};
 use super::error::ModelError;
 use super::layout::Layout;
+use super::motor::Motor;
 use super::output::{Alarms, LineSettings, Output};
 use crate::line::{LineDecoder, Micros};
 use crate::memory::{Memory, ParamMap};
@@ -48,6 +49,8 @@ pub struct Drive {
     pub(super) digital_outputs: u16,
     /// Last seen state of each command bit (for the `latched` reading of HPD-ERRATUM-012).
     pub(super) command_seen: Vec<bool>,
+    /// The motor beyond what the parameters hold (manual 3.3, 3.6).
+    pub(super) motor: Motor,
 }
 
 impl Drive {
@@ -88,7 +91,7 @@ impl Drive {
 
     /// Builds a drive powered up at time 0 in the configured state (manual 4.1, 3.2).
     pub fn new(spec: &Spec, config: DriveConfig) -> Result<Drive, ModelError> {
-        let layout = Arc::new(Layout::new(spec, &config.readings)?);
+        let layout = Arc::new(Layout::new(spec, &config.readings, config.motion)?);
         let mut saved = Memory::default();
         masked_copy(
             &mut saved,
@@ -113,6 +116,7 @@ impl Drive {
             inputs: 0,
             digital_outputs: 0,
             command_seen: vec![false; layout.commands.len()],
+            motor: Motor::default(),
             layout,
         };
         if let Start::Commissioned { baud_code, address } = config.start {
@@ -193,6 +197,7 @@ impl Drive {
         self.plc_state = PlcState::default();
         self.pending.clear();
         self.command_seen.iter_mut().for_each(|s| *s = false);
+        self.reset_motor();
         // HPD-PLC-004: scans every 6.144 ms from power-up.
         self.next_scan = self.epoch.checked_add(layout.scan_us);
         if self.digital_outputs != 0 {

@@ -3,6 +3,7 @@
 //! appendix G program (manual 4.2, 3.3, 3.4, 3.6, 3.8.1, chapter 4).
 
 use super::error::ModelError;
+use super::motor::{MotionStyle, MotorLayout, PositionCommand};
 use super::names;
 use crate::line::Micros;
 use crate::memory::{BitAddr, Memory, ParamMap, Slot};
@@ -86,7 +87,9 @@ pub(super) enum CommandKind {
     SavePlc,
     /// b99.15: save the parameters.
     SaveParams,
-    /// A command whose effect needs what the model has not (analogue input, motor).
+    /// A position command of modes 9–11 (b70.2, b70.10–b70.12).
+    Position(PositionCommand),
+    /// A command whose effect needs what the model has not (analogue input, current sensors).
     Other,
 }
 
@@ -179,6 +182,7 @@ pub(super) struct Layout {
     pub(super) setup: Setup,
     pub(super) scan_us: Micros,
     pub(super) fin_us: Micros,
+    pub(super) motor: MotorLayout,
 }
 
 fn spec_error(what: impl Into<String>) -> ModelError {
@@ -187,7 +191,11 @@ fn spec_error(what: impl Into<String>) -> ModelError {
 
 impl Layout {
     /// Resolves everything from the spec with the erratum readings in force.
-    pub(super) fn new(spec: &Spec, readings: &Readings) -> Result<Layout, ModelError> {
+    pub(super) fn new(
+        spec: &Spec,
+        readings: &Readings,
+        style: MotionStyle,
+    ) -> Result<Layout, ModelError> {
         let family = spec.family(FamilyId::Hpd);
         let protocol = family
             .hpd()
@@ -298,7 +306,9 @@ impl Layout {
                             let kind = kinds
                                 .iter()
                                 .find(|(k, _)| *k == addr && bf.modes.is_empty())
-                                .map_or(CommandKind::Other, |(_, kind)| *kind);
+                                .map(|(_, kind)| *kind)
+                                .or_else(|| position_command(&bf.modes, b.bit))
+                                .unwrap_or(CommandKind::Other);
                             commands.push(Command {
                                 bit: addr,
                                 modes: bf.modes.clone(),
@@ -374,7 +384,9 @@ impl Layout {
         if protocol.idc.cmd != idc_cmd {
             return Err(spec_error("the IDC command is not the broadcast message"));
         }
+        let motor = MotorLayout::new(protocol, &map, style).map_err(spec_error)?;
         Ok(Layout {
+            motor,
             scan_us: Micros::from(runtime.scan_us()),
             fin_us: Micros::from(runtime.fin_period_us()),
             rules,
@@ -427,6 +439,24 @@ impl Layout {
     pub(super) fn alarm(&self, code: u8) -> Option<&Alarm> {
         self.alarms.iter().find(|a| a.code == code)
     }
+}
+
+/// The position command bit `y` of Pb70 is in the modes of its bitfield (manual 3.6.4–3.6.6).
+fn position_command(modes: &[u32], y: u32) -> Option<CommandKind> {
+    if !modes.iter().any(|m| names::POSITION_MODES.contains(m)) {
+        return None;
+    }
+    let [clear, zero, shaft, to_motor] = names::POSITION_COMMAND_BITS.map(u32::from);
+    let kind = match y {
+        _ if y == clear && modes.contains(&names::MODE_POSITIONER) => {
+            PositionCommand::ClearIncrement
+        }
+        _ if y == zero => PositionCommand::Zero,
+        _ if y == shaft => PositionCommand::Shaft,
+        _ if y == to_motor => PositionCommand::ReferenceToMotor,
+        _ => return None,
+    };
+    Some(CommandKind::Position(kind))
 }
 
 /// A parameter with a serial slot, its access, range and default.

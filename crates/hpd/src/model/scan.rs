@@ -1,5 +1,5 @@
 //! Virtual time (manual 3.8.1, appendix F): PLC scans every 6.144 ms, FIN copies every 512 µs,
-//! delayed answers, and the digital inputs and outputs.
+//! the motor every 2.048 ms while it moves, delayed answers, and the digital inputs and outputs.
 //!
 //! Scans and FIN slots count from the last power-up. Events due at the same time run as:
 //! delayed answers, then the FIN copy, then the scan. An input given at `now` is seen by
@@ -16,6 +16,7 @@ use std::sync::Arc;
 enum Event {
     Answer,
     Fin,
+    Motor,
     Scan,
 }
 
@@ -36,6 +37,10 @@ impl Drive {
                     }
                 }
                 Event::Fin => self.fast_inputs(t),
+                Event::Motor => {
+                    self.motor_tick(t);
+                    self.service(t);
+                }
                 Event::Scan => self.scan(t),
             }
         }
@@ -58,7 +63,8 @@ impl Drive {
         let answer = self.pending.front().map(|(t, _)| (*t, Event::Answer));
         let fin = self.next_fin().map(|t| (t, Event::Fin));
         let scan = self.next_scan.map(|t| (t, Event::Scan));
-        [answer, fin, scan].into_iter().flatten().min()
+        let motor = self.next_motor().map(|t| (t, Event::Motor));
+        [answer, fin, motor, scan].into_iter().flatten().min()
     }
 
     /// The next FIN slot after the current time, while a FIN instruction runs (HPD-PLC-030:
