@@ -5,8 +5,10 @@
 //! using, plus its answer delay (Pr26 = 4), the line time of the longest answer and the
 //! transport's slack. A step fails on any difference: other bytes, an answer where the
 //! reference is silent or silence where it answers, or an answer sooner than the reference's
-//! delay allows. The first failing step ends the judged part of a case; its clean-up steps
-//! still run. On a transport that cannot reset the device, the reference is brought back in
+//! delay allows. An answer that had not come by the end of its window is waited for, one
+//! window more, before the next message goes out and reported as late bytes: a late answer
+//! is never taken for the answer to the next message. The first failing step ends the
+//! judged part of a case; its clean-up steps still run. On a transport that cannot reset the device, the reference is brought back in
 //! line after a failure by reading the parameters the case touched from the device.
 
 use super::readings::{Bases, Journal, Judge};
@@ -46,6 +48,9 @@ pub struct HpdSession<'a, 's> {
     bases: Bases,
     /// The current case as the reference was given it, to replay on other readings.
     journal: Journal,
+    /// What the line may still carry: `None` when nothing was sent since the device started,
+    /// else the bytes of the last answer that had not come by the end of its window.
+    owed: Option<usize>,
 }
 
 /// The requirement that fixes the scan period but not its phase (3.8.1).
@@ -95,6 +100,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             shown: suite.readings.strict().clone(),
             bases: Bases::default(),
             journal: Journal::default(),
+            owed: None,
         };
         session.oracle = session.base();
         session
@@ -115,6 +121,7 @@ impl<'a, 's> HpdSession<'a, 's> {
     fn reset_oracle(&mut self) {
         self.oracle = self.base();
         self.offset = self.link.now();
+        self.owed = None;
     }
 
     /// Whether the reference follows the adopted reading of every erratum (the golden
@@ -374,6 +381,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             Ok(g) => g,
             Err(e) => return Err((e, expected)),
         };
+        self.owed = Some(want.saturating_sub(concat(&got).len()));
         Ok(Observed {
             expected,
             got,
@@ -383,32 +391,55 @@ impl<'a, 's> HpdSession<'a, 's> {
     }
 
     /// Bytes that came after the last answer window (a late answer, already judged where
-    /// it belonged): dropped so they are not taken for the next answer.
+    /// it belonged): dropped so they are not taken for the next answer. The drive answers
+    /// only when asked, one answer per message (4.1), so an answer still owed is waited for,
+    /// up to one more answer window, before the next message goes out; then the line is
+    /// swept. Nothing is waited for when nothing was sent since the device started.
     fn drain_late(&mut self) -> Vec<u8> {
+        let Some(owed) = self.owed.take() else {
+            return Vec::new();
+        };
         if self.link.caps().virtual_time {
             return Vec::new();
         }
+        let mut late = Vec::new();
+        if owed > 0 {
+            let until = self.link.now() + self.window();
+            if let Ok(c) = self.link.recv(until, &mut |b| b.len() >= owed) {
+                late = concat(&c);
+            }
+        }
         let now = self.link.now();
-        self.link
-            .recv(now + 1, &mut |_| false)
-            .map(|c| concat(&c))
-            .unwrap_or_default()
+        if let Ok(c) = self.link.recv(now + 1, &mut |_| false) {
+            late.extend(concat(&c));
+        }
+        late
     }
 
     /// Listens for `us` on both.
+    /// An answer still owed to the last message is waited for first (and reported as late).
     fn listen(&mut self, us: Micros) -> Result<Observed, (LinkError, Vec<Chunk>)> {
+        let late = if self.owed.is_some_and(|n| n > 0) {
+            self.drain_late()
+        } else {
+            Vec::new()
+        };
         let t0 = self.link.now();
         let o0 = self.oracle_now(t0);
         self.oracle.advance(o0 + us);
         self.journal.listen(o0 + us);
         let expected = self.oracle_output(o0, t0);
         match self.link.recv(t0 + us, &mut |_| false) {
-            Ok(got) => Ok(Observed {
-                expected,
-                got,
-                t0,
-                late: Vec::new(),
-            }),
+            Ok(got) => {
+                let want = concat(&expected).len();
+                self.owed = Some(want.saturating_sub(concat(&got).len()));
+                Ok(Observed {
+                    expected,
+                    got,
+                    t0,
+                    late,
+                })
+            }
             Err(e) => Err((e, expected)),
         }
     }
@@ -460,6 +491,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             let Ok(bytes) = msg.to_bytes(&self.suite.rules) else {
                 continue;
             };
+            let _ = self.drain_late();
             let window = self.window();
             let t0 = self.link.now();
             if self.link.send(&bytes).is_err() {
@@ -468,6 +500,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             let Ok(got) = self.link.recv(t0 + window, &mut |b| b.len() >= 5) else {
                 return;
             };
+            self.owed = Some(5usize.saturating_sub(concat(&got).len()));
             let got = concat(&got);
             if let Ok(Message::Response { par, data, .. }) =
                 drivespec_hpd::parse(&self.suite.rules, &got)
@@ -732,8 +765,10 @@ impl HpdSession<'_, '_> {
     /// unjudged: a just-started process is then talking (its start-up grace is over). True
     /// when bytes came.
     pub fn wake(&mut self, bytes: &[u8]) -> bool {
+        let _ = self.drain_late();
         let window = self.window();
         let t0 = self.link.now();
+        self.owed = Some(0);
         if self.link.send(bytes).is_err() {
             return false;
         }
@@ -969,11 +1004,7 @@ impl HpdSession<'_, '_> {
                                 );
                             }
                             if !obs.late.is_empty() {
-                                let n = format!(
-                                    "{} late byte(s) dropped before the request: {}",
-                                    obs.late.len(),
-                                    to_hex(&obs.late)
-                                );
+                                let n = late_note(&obs.late);
                                 rec.note = Some(match rec.note.take() {
                                     Some(x) => format!("{x}; {n}"),
                                     None => n,
@@ -988,6 +1019,11 @@ impl HpdSession<'_, '_> {
                 }
                 Action::Send { bytes } => {
                     rec.sent = Some(to_hex(bytes));
+                    let late = self.drain_late();
+                    if !late.is_empty() {
+                        rec.note = Some(late_note(&late));
+                    }
+                    self.owed = Some(0);
                     let t = self.link.now();
                     let o = self.oracle_now(t);
                     self.oracle.handle_rx(o, bytes);
@@ -1007,6 +1043,13 @@ impl HpdSession<'_, '_> {
                     rec.note = Some(format!("listened {us} µs"));
                     match self.listen(us) {
                         Ok(obs) => {
+                            if !obs.late.is_empty() {
+                                rec.note = Some(format!(
+                                    "{}; {}",
+                                    late_note(&obs.late),
+                                    rec.note.take().unwrap_or_default()
+                                ));
+                            }
                             let mut ea = self.answer(&obs.expected, obs.t0, last_request.as_ref());
                             let ga = self.answer(&obs.got, obs.t0, last_request.as_ref());
                             let exp = concat(&obs.expected);
@@ -1216,6 +1259,15 @@ impl HpdSession<'_, '_> {
             elapsed_us,
         }
     }
+}
+
+/// The note on late bytes dropped before a request.
+fn late_note(late: &[u8]) -> String {
+    format!(
+        "{} late byte(s) dropped before the request: {}",
+        late.len(),
+        to_hex(late)
+    )
 }
 
 fn show(a: &Answer) -> String {
