@@ -2,8 +2,8 @@
 //! choice to the implementation (4.3 fixes maxima of acceleration and deceleration, not a
 //! profile; chapter 3 fixes no reaction time), as a second team's drive would behave.
 
-use super::mutants::spec;
-use drivespec_conform::cyclic::{CyclicDevice, Env};
+use crate::spec;
+use drivespec_cyclic::{CyclicDevice, Env};
 use drivespec_positioner::Micros;
 use drivespec_psd4xx::model::{Drive, DriveConfig, RecordAnswer, RecordFailure, RecordRequest};
 use drivespec_psd4xx::{Input, Output, PkwResponse, Request, Width};

@@ -6,9 +6,9 @@
 //! - a PLC whose 6.144 ms scan (3.8.1) runs at another phase from power-up;
 //! - answers sent later than the reference sends them, within the time-out (4.1).
 
-use super::mutants::spec;
-use drivespec_conform::link::Micros;
+use crate::spec;
 use drivespec_hpd::model::{Drive, DriveConfig, Output};
+use drivespec_link::Micros;
 use drivespec_sim::SimDevice;
 use drivespec_spec::{FamilyId, Readings};
 
