@@ -7,9 +7,14 @@
 //! reference is silent or silence where it answers, or an answer sooner than the reference's
 //! delay allows. An answer that had not come by the end of its window is waited for, one
 //! window more, before the next message goes out and reported as late bytes: a late answer
-//! is never taken for the answer to the next message. The first failing step ends the
-//! judged part of a case; its clean-up steps still run. On a transport that cannot reset the device, the reference is brought back in
-//! line after a failure by reading the parameters the case touched from the device.
+//! is never taken for the answer to the next message. A message split by a pause within the
+//! time-out pauses half the time-out, at most the time-out less the slack, so a transport that
+//! holds the rest back by up to its slack cannot carry it past the time-out; where the
+//! time-out is shorter than that, the device's silence to the rest is an open point, not a
+//! failure (sim's slack is 1 ms: there every code is judged). The first
+//! failing step ends the judged part of a case; its clean-up steps still run. On a transport
+//! that cannot reset the device, the reference is brought back in line after a failure by
+//! reading the parameters the case touched from the device.
 
 use super::readings::{Bases, Journal, Judge};
 use super::step::{Action, Compare, HpdCase, Step};
@@ -48,10 +53,15 @@ pub struct HpdSession<'a, 's> {
     bases: Bases,
     /// The current case as the reference was given it, to replay on other readings.
     journal: Journal,
-    /// What the line may still carry: `None` when nothing was sent since the device started,
-    /// else the bytes of the last answer that had not come by the end of its window.
-    owed: Option<usize>,
+    /// The bytes of the last answer that had not come by the end of its window.
+    owed: usize,
+    /// The last pause of a split message left the rest less than the transport's slack before
+    /// the message time-out: whether it came in time is the transport's, not the device's.
+    split_late: bool,
 }
+
+/// The requirement that a message is complete within the Pr26 time-out (4 table; 4.1).
+const TIMEOUT_REQUIREMENT: &str = "HPD-BAUD-002";
 
 /// The requirement that fixes the scan period but not its phase (3.8.1).
 const SCAN_REQUIREMENT: &str = "HPD-PLC-004";
@@ -100,7 +110,8 @@ impl<'a, 's> HpdSession<'a, 's> {
             shown: suite.readings.strict().clone(),
             bases: Bases::default(),
             journal: Journal::default(),
-            owed: None,
+            owed: 0,
+            split_late: false,
         };
         session.oracle = session.base();
         session
@@ -121,7 +132,7 @@ impl<'a, 's> HpdSession<'a, 's> {
     fn reset_oracle(&mut self) {
         self.oracle = self.base();
         self.offset = self.link.now();
-        self.owed = None;
+        self.owed = 0;
     }
 
     /// Whether the reference follows the adopted reading of every erratum (the golden
@@ -381,7 +392,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             Ok(g) => g,
             Err(e) => return Err((e, expected)),
         };
-        self.owed = Some(want.saturating_sub(concat(&got).len()));
+        self.owed = want.saturating_sub(concat(&got).len());
         Ok(Observed {
             expected,
             got,
@@ -394,11 +405,9 @@ impl<'a, 's> HpdSession<'a, 's> {
     /// it belonged): dropped so they are not taken for the next answer. The drive answers
     /// only when asked, one answer per message (4.1), so an answer still owed is waited for,
     /// up to one more answer window, before the next message goes out; then the line is
-    /// swept. Nothing is waited for when nothing was sent since the device started.
+    /// swept.
     fn drain_late(&mut self) -> Vec<u8> {
-        let Some(owed) = self.owed.take() else {
-            return Vec::new();
-        };
+        let owed = std::mem::take(&mut self.owed);
         if self.link.caps().virtual_time {
             return Vec::new();
         }
@@ -419,7 +428,7 @@ impl<'a, 's> HpdSession<'a, 's> {
     /// Listens for `us` on both.
     /// An answer still owed to the last message is waited for first (and reported as late).
     fn listen(&mut self, us: Micros) -> Result<Observed, (LinkError, Vec<Chunk>)> {
-        let late = if self.owed.is_some_and(|n| n > 0) {
+        let late = if self.owed > 0 {
             self.drain_late()
         } else {
             Vec::new()
@@ -432,7 +441,7 @@ impl<'a, 's> HpdSession<'a, 's> {
         match self.link.recv(t0 + us, &mut |_| false) {
             Ok(got) => {
                 let want = concat(&expected).len();
-                self.owed = Some(want.saturating_sub(concat(&got).len()));
+                self.owed = want.saturating_sub(concat(&got).len());
                 Ok(Observed {
                     expected,
                     got,
@@ -500,7 +509,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             let Ok(got) = self.link.recv(t0 + window, &mut |b| b.len() >= 5) else {
                 return;
             };
-            self.owed = Some(5usize.saturating_sub(concat(&got).len()));
+            self.owed = 5usize.saturating_sub(concat(&got).len());
             let got = concat(&got);
             if let Ok(Message::Response { par, data, .. }) =
                 drivespec_hpd::parse(&self.suite.rules, &got)
@@ -768,7 +777,6 @@ impl HpdSession<'_, '_> {
         let _ = self.drain_late();
         let window = self.window();
         let t0 = self.link.now();
-        self.owed = Some(0);
         if self.link.send(bytes).is_err() {
             return false;
         }
@@ -933,6 +941,7 @@ impl HpdSession<'_, '_> {
                     silence_ok,
                 } => {
                     let golden = &step.golden;
+                    let split_late = std::mem::take(&mut self.split_late);
                     let request = drivespec_hpd::parse(&suite.rules, bytes).ok();
                     rec.sent = Some(to_hex(bytes));
                     rec.sent_text = Some(self.words(bytes, None));
@@ -958,6 +967,19 @@ impl HpdSession<'_, '_> {
                                     also: &mut also,
                                 };
                                 ok = self.judged(judge, ok, &obs, request.as_ref(), &mut other);
+                            }
+                            if !ok && judged && split_late && got.is_empty() {
+                                let (timeout, _, _) = self.line_times();
+                                ok = true;
+                                findings.push(Finding::Open {
+                                    requirement: TIMEOUT_REQUIREMENT.to_owned(),
+                                    text: format!(
+                                        "{}: the rest of the message went out less than the transport's slack ({} ms) before the {} ms time-out; the device dropped it as late, which this transport cannot tell from a device fault",
+                                        step.text,
+                                        self.slack / 1000,
+                                        timeout / 1000
+                                    ),
+                                });
                             }
                             let mut why = format!("expected {}, got {}", show(&ea), show(&ga));
                             if let (true, Some(ed), Some(gd)) =
@@ -1023,7 +1045,6 @@ impl HpdSession<'_, '_> {
                     if !late.is_empty() {
                         rec.note = Some(late_note(&late));
                     }
-                    self.owed = Some(0);
                     let t = self.link.now();
                     let o = self.oracle_now(t);
                     self.oracle.handle_rx(o, bytes);
@@ -1038,8 +1059,12 @@ impl HpdSession<'_, '_> {
                     let us = match step.action {
                         Action::Listen { us } => us,
                         Action::ListenTimeout {} => timeout + self.slack.max(1_000),
-                        _ => timeout / 2,
+                        // A pause that, with the transport's slack, could carry the rest of
+                        // the message past the time-out is shortened, to none at the least.
+                        _ => (timeout / 2).min(timeout.saturating_sub(self.slack)),
                     };
+                    self.split_late = matches!(step.action, Action::ListenHalfTimeout {})
+                        && timeout.saturating_sub(us) < self.slack;
                     rec.note = Some(format!("listened {us} µs"));
                     match self.listen(us) {
                         Ok(obs) => {
