@@ -1,4 +1,4 @@
-//! Mutation tests: the reference drive with one planted deviation (`support::mutants`) as the
+//! Mutation tests: the reference drive with one planted deviation (`drivespec_implementations::hpd_mutants`) as the
 //! device under test. Each mutant must fail at least the cases named for it, and every case it
 //! fails must cite one of the requirements the deviation breaks (no collateral failures). The
 //! score is printed. A mutant following another reading of an erratum is judged with the
@@ -16,8 +16,9 @@ use drivespec_conform::case::Outcome;
 use drivespec_conform::hpd::HpdSuite;
 use drivespec_conform::select::Pattern;
 use drivespec_conform::suite::{Session, Settings, Suite};
+use drivespec_implementations::hpd_mutants::{mutants, strict_readings, Kind, Mutant};
+use drivespec_implementations::spec;
 use drivespec_sim::SimLink;
-use support::mutants::{mutants, spec, strict_readings, Kind, Mutant};
 
 #[test]
 fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
@@ -109,7 +110,10 @@ fn a_failure_names_the_broken_requirement_first() {
 }
 
 /// Runs the case `id` of the HPD suite against `kind`.
-fn run_one(kind: support::mutants::Kind, id: &str) -> drivespec_conform::case::CaseRun {
+fn run_one(
+    kind: drivespec_implementations::hpd_mutants::Kind,
+    id: &str,
+) -> drivespec_conform::case::CaseRun {
     let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
     let link = SimLink::new("mutant", Box::new(Mutant::new(kind)));
     let mut session = suite.session(Box::new(link));
@@ -122,7 +126,7 @@ fn run_one(kind: support::mutants::Kind, id: &str) -> drivespec_conform::case::C
 #[test]
 fn a_missing_answer_to_a_set_up_write_fails_naming_the_acknowledge_rule() {
     let run = run_one(
-        support::mutants::Kind::SilentSetupWrite,
+        drivespec_implementations::hpd_mutants::Kind::SilentSetupWrite,
         "hpd/param/Pr33/min",
     );
     let Outcome::Fail(f) = run.outcome else {
@@ -170,7 +174,7 @@ fn clean_up_writes_back_the_devices_own_value() {
 /// the requirements it breaks.
 #[test]
 fn every_motion_mutant_fails_citing_its_requirement_first() {
-    use support::hpd_motion_mutants::{motion_mutants, MotionMutant};
+    use drivespec_implementations::hpd_motion_mutants::{motion_mutants, MotionMutant};
     let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
     let mut problems = Vec::new();
     let mut report = Vec::new();

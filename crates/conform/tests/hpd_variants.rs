@@ -1,4 +1,4 @@
-//! HPD legal variants (`support::hpd_variants`): drives that differ from the reference only
+//! HPD legal variants (`drivespec_implementations::hpd_variants`): drives that differ from the reference only
 //! where the manual allows must pass every case (0 failures). The findings each variant
 //! showed (which erratum reading it follows, points the manual leaves open) are printed.
 #![allow(
@@ -13,11 +13,11 @@ mod support;
 use drivespec_conform::case::Outcome;
 use drivespec_conform::hpd::HpdSuite;
 use drivespec_conform::suite::{Session, Settings, Suite};
+use drivespec_implementations::hpd_variants::{variants, Variant};
+use drivespec_implementations::spec;
 use drivespec_sim::SimLink;
 use std::collections::BTreeSet;
-use support::hpd_variants::{variants, Variant};
 use support::legal::describe;
-use support::mutants::spec;
 
 #[test]
 fn every_hpd_legal_variant_passes() {

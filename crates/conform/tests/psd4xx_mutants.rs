@@ -1,5 +1,5 @@
 //! PSD4xx mutation tests: the reference drive with one planted deviation
-//! (`support::psd4xx_mutants`, served over the cyclic protocol in-process) as the device under
+//! (`drivespec_implementations::psd4xx_mutants`, served over the cyclic protocol in-process) as the device under
 //! test. Each mutant must fail the cases named for it, and every case it fails must cite a
 //! requirement the deviation breaks; the mutation score is printed.
 #![allow(
@@ -16,8 +16,8 @@ use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::psd4xx::Psd4xxSuite;
 use drivespec_conform::select::Pattern;
 use drivespec_conform::suite::{Session, Settings, Suite};
-use support::mutants::spec;
-use support::psd4xx_mutants::{mutants, Mutant};
+use drivespec_implementations::psd4xx_mutants::{mutants, Mutant};
+use drivespec_implementations::spec;
 
 #[test]
 fn every_psd4xx_mutant_fails_the_cases_covering_its_deviation() {

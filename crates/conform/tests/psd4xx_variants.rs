@@ -1,4 +1,4 @@
-//! PSD4xx legal variants (`support::psd4xx_variants`): drives that differ from the reference
+//! PSD4xx legal variants (`drivespec_implementations::psd4xx_variants`): drives that differ from the reference
 //! only where the manual allows must pass every case. The cases each variant fails are printed.
 #![allow(
     clippy::unwrap_used,
@@ -12,9 +12,9 @@ mod support;
 use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::psd4xx::Psd4xxSuite;
 use drivespec_conform::suite::{Settings, Suite};
+use drivespec_implementations::psd4xx_variants::{variants, Variant};
+use drivespec_implementations::spec;
 use support::legal::{describe, failures};
-use support::mutants::spec;
-use support::psd4xx_variants::{variants, Variant};
 
 #[test]
 fn every_psd4xx_legal_variant_passes() {

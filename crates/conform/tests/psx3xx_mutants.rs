@@ -1,5 +1,5 @@
 //! PSx3xx mutation tests: the reference drive with one planted deviation
-//! (`support::psx3xx_mutants`), served over the cyclic protocol in-process, as the device under
+//! (`drivespec_implementations::psx3xx_mutants`), served over the cyclic protocol in-process, as the device under
 //! test. Each mutant must fail the cases named for it, and every case it fails must cite a
 //! requirement the deviation breaks; the mutation score is printed.
 #![allow(
@@ -16,8 +16,8 @@ use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::psx3xx::Psx3xxSuite;
 use drivespec_conform::select::Pattern;
 use drivespec_conform::suite::{Session, Settings, Suite};
-use support::mutants::spec;
-use support::psx3xx_mutants::{mutants, suite_mutants, Kind, Mutant};
+use drivespec_implementations::psx3xx_mutants::{mutants, suite_mutants, Kind, Mutant};
+use drivespec_implementations::spec;
 
 #[test]
 fn every_psx3xx_mutant_fails_the_cases_covering_its_deviation() {

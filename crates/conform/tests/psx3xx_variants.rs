@@ -1,4 +1,4 @@
-//! PSx3xx legal variants (`support::psx3xx_variants`): drives that differ from the reference
+//! PSx3xx legal variants (`drivespec_implementations::psx3xx_variants`): drives that differ from the reference
 //! only where the manual allows. Each must pass every case; the cases a variant fails are
 //! printed with what the suite expected and what came.
 #![allow(
@@ -13,9 +13,9 @@ mod support;
 use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::psx3xx::Psx3xxSuite;
 use drivespec_conform::suite::{Settings, Suite};
+use drivespec_implementations::psx3xx_variants::{variants, Variant};
+use drivespec_implementations::spec;
 use support::legal::{describe, failures};
-use support::mutants::spec;
-use support::psx3xx_variants::{variants, Variant};
 
 #[test]
 fn every_psx3xx_legal_variant_passes() {
@@ -36,7 +36,7 @@ fn every_psx3xx_legal_variant_passes() {
 fn bit_11_after_an_aborted_run_is_reported_as_the_open_point() {
     use drivespec_conform::case::{Finding, Outcome};
     use drivespec_conform::suite::Session;
-    use support::psx3xx_variants::Kind;
+    use drivespec_implementations::psx3xx_variants::Kind;
     let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
     let index = suite
         .cases()

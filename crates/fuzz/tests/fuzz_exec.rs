@@ -14,9 +14,9 @@ mod support;
 use drivespec_conform::dut::Dut;
 use drivespec_conform::Progress;
 use drivespec_fuzz::{self as fuzz, FindingClass, Options};
+use drivespec_implementations::spec;
 use std::path::PathBuf;
 use std::time::Duration;
-use support::mutants::spec;
 
 /// The Python interpreter itself (not a shim), or None.
 fn python() -> Option<String> {

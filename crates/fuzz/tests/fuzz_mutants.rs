@@ -1,4 +1,4 @@
-//! The fuzzer against every HPD mutant of the conformance tests (`support::mutants`): for a
+//! The fuzzer against every HPD mutant of the conformance tests (`drivespec_implementations::hpd_mutants`): for a
 //! fixed seed it finds the planted bug within a bounded number of sequences, and the
 //! minimised replay is short (at most 5 exchanges for bugs one message shows; the PLC
 //! arithmetic bugs need a program uploaded and run). Prints iterations and replay lengths.
@@ -14,8 +14,9 @@ mod support;
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
 use drivespec_fuzz::{self as fuzz, FindingClass, Options};
+use drivespec_implementations::hpd_mutants::{mutants, strict_readings, Kind, Mutant};
+use drivespec_implementations::spec;
 use drivespec_sim::SimLink;
-use support::mutants::{mutants, spec, strict_readings, Kind, Mutant};
 
 /// Sequences each mutant gets.
 const BOUND: u64 = 80;

@@ -1,4 +1,4 @@
-//! `drivespec fuzz psd4xx`: against every PSD4xx mutant (`support::psd4xx_mutants`) the
+//! `drivespec fuzz psd4xx`: against every PSD4xx mutant (`drivespec_implementations::psd4xx_mutants`) the
 //! fuzzer finds the planted bug within a bounded number of sequences for a fixed seed, with a
 //! short minimised replay; a long fixed-seed run against the reference finds nothing; the same
 //! seed gives byte-identical replay files, and they replay byte for byte; `exec:` works
@@ -16,14 +16,14 @@ mod support;
 use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_conform::dut::Dut;
 use drivespec_fuzz::{self as fuzz, Action, Device, FindingClass, Options, Replay};
+use drivespec_implementations::psd4xx_mutants::{mutants, Kind, Mutant};
+use drivespec_implementations::spec;
 use drivespec_spec::FamilyId;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use support::cyclic::{
     a_finding_replays, every_mutant_is_found, mutant_options, the_reference_gives_nothing,
 };
-use support::mutants::spec;
-use support::psd4xx_mutants::{mutants, Kind, Mutant};
 
 /// Sequences each mutant gets.
 const BOUND: u64 = 120;

@@ -1,4 +1,4 @@
-//! `drivespec fuzz psx3xx`: against every PSx3xx mutant (`support::psx3xx_mutants`) the
+//! `drivespec fuzz psx3xx`: against every PSx3xx mutant (`drivespec_implementations::psx3xx_mutants`) the
 //! fuzzer finds the planted bug within a bounded number of sequences for a fixed seed, with a
 //! short minimised replay; a fixed-seed run against the reference finds nothing; the same seed
 //! gives byte-identical replay files, and they replay byte for byte; replay files of another
@@ -14,13 +14,13 @@ mod support;
 
 use drivespec_conform::cyclic::{LocalPeer, Server};
 use drivespec_fuzz::{self as fuzz, Action, Device, Options, Replay};
+use drivespec_implementations::psx3xx_mutants::{mutants, Kind, Mutant};
+use drivespec_implementations::spec;
 use drivespec_psx3xx::step::Step as PsxStep;
 use drivespec_spec::FamilyId;
 use support::cyclic::{
     a_finding_replays, every_mutant_is_found, mutant_options, the_reference_gives_nothing,
 };
-use support::mutants::spec;
-use support::psx3xx_mutants::{mutants, Kind, Mutant};
 
 /// Sequences each mutant gets.
 const BOUND: u64 = 150;

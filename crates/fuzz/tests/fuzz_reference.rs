@@ -11,7 +11,7 @@ mod support;
 
 use drivespec_conform::Progress;
 use drivespec_fuzz::{self as fuzz, Options};
-use support::mutants::spec;
+use drivespec_implementations::spec;
 
 fn opts(seed: u64, iterations: u64) -> Options {
     let mut o = Options {

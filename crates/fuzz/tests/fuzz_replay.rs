@@ -14,9 +14,10 @@ use drivespec_conform::dut::Dut;
 use drivespec_conform::Progress;
 use drivespec_fuzz::{self as fuzz, Action, Options, Replay, Step};
 use drivespec_hpd::step::{Compare, Step as HpdStep};
+use drivespec_implementations::hpd_mutants::{Kind, Mutant};
+use drivespec_implementations::spec;
 use drivespec_sim::SimLink;
 use std::path::PathBuf;
-use support::mutants::{spec, Kind, Mutant};
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("drivespec-fuzz-{}-{name}", std::process::id()));

@@ -713,7 +713,7 @@ impl<'s> Gen<'s> {
     }
 
     /// Re-addresses the device from `from` to `to` (manual 4.1 set-up: Pr27, b99.6 for b42.3,
-    /// then b42.3), with word writes. Leaves the PLC stopped and b99.6 = 1.
+    /// then b42.3 cleared and set), with word writes. Leaves the PLC stopped and b99.6 = 1.
     pub(crate) fn readdress(&mut self, cb: &mut CaseB, role: Role, from: u8, to: u8) {
         let (Some(pr27), Some(pb42), Some(reinit), Some(ext)) = (
             self.slot_of(&self.protocol.serial_setup.address_param),
@@ -736,7 +736,18 @@ impl<'s> Gen<'s> {
             i64::from(v99),
             "Pb99 (b99.6 = 1, PLC stopped)",
         );
-        let v42 = self.base(pb42) | bit_value(pb42, reinit.at);
+        // b42.3 cleared first: a drive that keeps a command bit until the master clears it
+        // (HPD-ERRATUM-012) sees the command only on a change to 1.
+        let v42 = self.base(pb42) & !bit_value(pb42, reinit.at);
+        self.write_at(
+            cb,
+            role,
+            from,
+            pb42,
+            i64::from(v42),
+            "Pb42 (b42.3 = 0, so the next write sets it)",
+        );
+        let v42 = v42 | bit_value(pb42, reinit.at);
         self.write_at(
             cb,
             role,

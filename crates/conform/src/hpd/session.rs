@@ -5,9 +5,16 @@
 //! using, plus its answer delay (Pr26 = 4), the line time of the longest answer and the
 //! transport's slack. A step fails on any difference: other bytes, an answer where the
 //! reference is silent or silence where it answers, or an answer sooner than the reference's
-//! delay allows. The first failing step ends the judged part of a case; its clean-up steps
-//! still run. On a transport that cannot reset the device, the reference is brought back in
-//! line after a failure by reading the parameters the case touched from the device.
+//! delay allows. An answer that had not come by the end of its window is waited for, one
+//! window more, before the next message goes out and reported as late bytes: a late answer
+//! is never taken for the answer to the next message. A message split by a pause within the
+//! time-out pauses half the time-out, at most the time-out less the slack, so a transport that
+//! holds the rest back by up to its slack cannot carry it past the time-out; where the
+//! time-out is shorter than that, the device's silence to the rest is an open point, not a
+//! failure (sim's slack is 1 ms: there every code is judged). The first
+//! failing step ends the judged part of a case; its clean-up steps still run. On a transport
+//! that cannot reset the device, the reference is brought back in line after a failure by
+//! reading the parameters the case touched from the device.
 
 use super::motion::{self, Round, Sample};
 use super::readings::{Bases, Journal, Judge};
@@ -48,7 +55,15 @@ pub struct HpdSession<'a, 's> {
     bases: Bases,
     /// The current case as the reference was given it, to replay on other readings.
     journal: Journal,
+    /// The bytes of the last answer that had not come by the end of its window.
+    owed: usize,
+    /// The last pause of a split message left the rest less than the transport's slack before
+    /// the message time-out: whether it came in time is the transport's, not the device's.
+    split_late: bool,
 }
+
+/// The requirement that a message is complete within the Pr26 time-out (4 table; 4.1).
+const TIMEOUT_REQUIREMENT: &str = "HPD-BAUD-002";
 
 /// The requirement that fixes the scan period but not its phase (3.8.1).
 const SCAN_REQUIREMENT: &str = "HPD-PLC-004";
@@ -97,6 +112,8 @@ impl<'a, 's> HpdSession<'a, 's> {
             shown: suite.readings.strict().clone(),
             bases: Bases::default(),
             journal: Journal::default(),
+            owed: 0,
+            split_late: false,
         };
         session.oracle = session.base();
         session
@@ -117,6 +134,7 @@ impl<'a, 's> HpdSession<'a, 's> {
     fn reset_oracle(&mut self) {
         self.oracle = self.base();
         self.offset = self.link.now();
+        self.owed = 0;
     }
 
     /// Whether the reference follows the adopted reading of every erratum (the golden
@@ -376,6 +394,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             Ok(g) => g,
             Err(e) => return Err((e, expected)),
         };
+        self.owed = want.saturating_sub(concat(&got).len());
         Ok(Observed {
             expected,
             got,
@@ -385,32 +404,53 @@ impl<'a, 's> HpdSession<'a, 's> {
     }
 
     /// Bytes that came after the last answer window (a late answer, already judged where
-    /// it belonged): dropped so they are not taken for the next answer.
+    /// it belonged): dropped so they are not taken for the next answer. The drive answers
+    /// only when asked, one answer per message (4.1), so an answer still owed is waited for,
+    /// up to one more answer window, before the next message goes out; then the line is
+    /// swept.
     fn drain_late(&mut self) -> Vec<u8> {
+        let owed = std::mem::take(&mut self.owed);
         if self.link.caps().virtual_time {
             return Vec::new();
         }
+        let mut late = Vec::new();
+        if owed > 0 {
+            let until = self.link.now() + self.window();
+            if let Ok(c) = self.link.recv(until, &mut |b| b.len() >= owed) {
+                late = concat(&c);
+            }
+        }
         let now = self.link.now();
-        self.link
-            .recv(now + 1, &mut |_| false)
-            .map(|c| concat(&c))
-            .unwrap_or_default()
+        if let Ok(c) = self.link.recv(now + 1, &mut |_| false) {
+            late.extend(concat(&c));
+        }
+        late
     }
 
     /// Listens for `us` on both.
+    /// An answer still owed to the last message is waited for first (and reported as late).
     fn listen(&mut self, us: Micros) -> Result<Observed, (LinkError, Vec<Chunk>)> {
+        let late = if self.owed > 0 {
+            self.drain_late()
+        } else {
+            Vec::new()
+        };
         let t0 = self.link.now();
         let o0 = self.oracle_now(t0);
         self.oracle.advance(o0 + us);
         self.journal.listen(o0 + us);
         let expected = self.oracle_output(o0, t0);
         match self.link.recv(t0 + us, &mut |_| false) {
-            Ok(got) => Ok(Observed {
-                expected,
-                got,
-                t0,
-                late: Vec::new(),
-            }),
+            Ok(got) => {
+                let want = concat(&expected).len();
+                self.owed = want.saturating_sub(concat(&got).len());
+                Ok(Observed {
+                    expected,
+                    got,
+                    t0,
+                    late,
+                })
+            }
             Err(e) => Err((e, expected)),
         }
     }
@@ -462,6 +502,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             let Ok(bytes) = msg.to_bytes(&self.suite.rules) else {
                 continue;
             };
+            let _ = self.drain_late();
             let window = self.window();
             let t0 = self.link.now();
             if self.link.send(&bytes).is_err() {
@@ -470,6 +511,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             let Ok(got) = self.link.recv(t0 + window, &mut |b| b.len() >= 5) else {
                 return;
             };
+            self.owed = 5usize.saturating_sub(concat(&got).len());
             let got = concat(&got);
             if let Ok(Message::Response { par, data, .. }) =
                 drivespec_hpd::parse(&self.suite.rules, &got)
@@ -734,6 +776,7 @@ impl HpdSession<'_, '_> {
     /// unjudged: a just-started process is then talking (its start-up grace is over). True
     /// when bytes came.
     pub fn wake(&mut self, bytes: &[u8]) -> bool {
+        let _ = self.drain_late();
         let window = self.window();
         let t0 = self.link.now();
         if self.link.send(bytes).is_err() {
@@ -902,6 +945,7 @@ impl HpdSession<'_, '_> {
                     silence_ok,
                 } => {
                     let golden = &step.golden;
+                    let split_late = std::mem::take(&mut self.split_late);
                     let request = drivespec_hpd::parse(&suite.rules, bytes).ok();
                     rec.sent = Some(to_hex(bytes));
                     rec.sent_text = Some(self.words(bytes, None));
@@ -927,6 +971,19 @@ impl HpdSession<'_, '_> {
                                     also: &mut also,
                                 };
                                 ok = self.judged(judge, ok, &obs, request.as_ref(), &mut other);
+                            }
+                            if !ok && judged && split_late && got.is_empty() {
+                                let (timeout, _, _) = self.line_times();
+                                ok = true;
+                                findings.push(Finding::Open {
+                                    requirement: TIMEOUT_REQUIREMENT.to_owned(),
+                                    text: format!(
+                                        "{}: the rest of the message went out less than the transport's slack ({} ms) before the {} ms time-out; the device dropped it as late, which this transport cannot tell from a device fault",
+                                        step.text,
+                                        self.slack / 1000,
+                                        timeout / 1000
+                                    ),
+                                });
                             }
                             let mut why = format!("expected {}, got {}", show(&ea), show(&ga));
                             if let (true, Some(ed), Some(gd)) =
@@ -973,11 +1030,7 @@ impl HpdSession<'_, '_> {
                                 );
                             }
                             if !obs.late.is_empty() {
-                                let n = format!(
-                                    "{} late byte(s) dropped before the request: {}",
-                                    obs.late.len(),
-                                    to_hex(&obs.late)
-                                );
+                                let n = late_note(&obs.late);
                                 rec.note = Some(match rec.note.take() {
                                     Some(x) => format!("{x}; {n}"),
                                     None => n,
@@ -992,6 +1045,10 @@ impl HpdSession<'_, '_> {
                 }
                 Action::Send { bytes } => {
                     rec.sent = Some(to_hex(bytes));
+                    let late = self.drain_late();
+                    if !late.is_empty() {
+                        rec.note = Some(late_note(&late));
+                    }
                     let t = self.link.now();
                     let o = self.oracle_now(t);
                     self.oracle.handle_rx(o, bytes);
@@ -1006,11 +1063,22 @@ impl HpdSession<'_, '_> {
                     let us = match step.action {
                         Action::Listen { us } => us,
                         Action::ListenTimeout {} => timeout + self.slack.max(1_000),
-                        _ => timeout / 2,
+                        // A pause that, with the transport's slack, could carry the rest of
+                        // the message past the time-out is shortened, to none at the least.
+                        _ => (timeout / 2).min(timeout.saturating_sub(self.slack)),
                     };
+                    self.split_late = matches!(step.action, Action::ListenHalfTimeout {})
+                        && timeout.saturating_sub(us) < self.slack;
                     rec.note = Some(format!("listened {us} µs"));
                     match self.listen(us) {
                         Ok(obs) => {
+                            if !obs.late.is_empty() {
+                                rec.note = Some(format!(
+                                    "{}; {}",
+                                    late_note(&obs.late),
+                                    rec.note.take().unwrap_or_default()
+                                ));
+                            }
                             let mut ea = self.answer(&obs.expected, obs.t0, last_request.as_ref());
                             let ga = self.answer(&obs.got, obs.t0, last_request.as_ref());
                             let exp = concat(&obs.expected);
@@ -1472,6 +1540,15 @@ fn text_answer(text: String) -> Answer {
         text,
         delay_us: None,
     }
+}
+
+/// The note on late bytes dropped before a request.
+fn late_note(late: &[u8]) -> String {
+    format!(
+        "{} late byte(s) dropped before the request: {}",
+        late.len(),
+        to_hex(late)
+    )
 }
 
 fn show(a: &Answer) -> String {

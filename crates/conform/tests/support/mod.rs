@@ -1,6 +1,5 @@
-//! Shared test support: the HPD mutants (`mutants`), the PSD4xx mutants (`psd4xx_mutants`),
-//! the PSx3xx mutants (`psx3xx_mutants`) (the fuzzer's tests in `crates/fuzz` use these three
-//! too) and the variants. Each test file uses only part of it.
+//! Shared test support: running a suite against a legal variant (`legal`). The variants and
+//! mutants themselves are the crate `drivespec-implementations`.
 #![allow(
     dead_code,
     missing_docs,
@@ -10,11 +9,4 @@
     clippy::panic
 )]
 
-pub mod hpd_motion_mutants;
-pub mod hpd_variants;
 pub mod legal;
-pub mod mutants;
-pub mod psd4xx_mutants;
-pub mod psd4xx_variants;
-pub mod psx3xx_mutants;
-pub mod psx3xx_variants;

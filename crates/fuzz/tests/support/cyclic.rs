@@ -2,10 +2,10 @@
 //! found with a short replay that replays exactly, a fixed-seed run against the reference finds
 //! nothing and repeats, and a finding's replay file replays byte for byte.
 
-use super::mutants::spec;
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
 use drivespec_fuzz::{self as fuzz, Device, FindingClass, Options, Replay};
+use drivespec_implementations::spec;
 use drivespec_spec::FamilyId;
 use std::path::PathBuf;
 use std::time::Instant;

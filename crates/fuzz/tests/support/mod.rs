@@ -1,6 +1,7 @@
-//! Test support: the mutants of the conformance tests (`crates/conform/tests/support`), which
-//! the fuzzer must catch too, the checks the tests of both cyclic families share (`cyclic`),
-//! and the reference drive on a TCP port (`reference_server`, behind `faulty_relay.py`). Each test file uses only part of it.
+//! Test support: the checks the tests of both cyclic families share (`cyclic`) and the
+//! reference drive on a TCP port (`reference_server`, behind `faulty_relay.py`). The mutants
+//! the fuzzer must catch are the crate `drivespec-implementations`. Each test file uses only
+//! part of it.
 #![allow(
     dead_code,
     missing_docs,
@@ -11,10 +12,4 @@
 )]
 
 pub mod cyclic;
-#[path = "../../../conform/tests/support/mutants.rs"]
-pub mod mutants;
-#[path = "../../../conform/tests/support/psd4xx_mutants.rs"]
-pub mod psd4xx_mutants;
-#[path = "../../../conform/tests/support/psx3xx_mutants.rs"]
-pub mod psx3xx_mutants;
 pub mod reference_server;

@@ -10,7 +10,11 @@ use std::time::{Duration, Instant};
 pub fn start(limit: Duration) -> u16 {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let port = listener.local_addr().unwrap().port();
-    let proto = Drive::new(super::mutants::spec(), DriveConfig::commissioned(0)).unwrap();
+    let proto = Drive::new(
+        drivespec_implementations::spec(),
+        DriveConfig::commissioned(0),
+    )
+    .unwrap();
     std::thread::spawn(move || {
         listener.set_nonblocking(true).unwrap();
         let started = Instant::now();

@@ -2,19 +2,13 @@
 //! or an erratum reading other than the adopted one), shared by the mutation test
 //! (`hpd_mutants.rs`) and the fuzzer tests (`crates/fuzz/tests/fuzz_*.rs`).
 
-use drivespec_conform::link::Micros;
+use crate::spec;
 use drivespec_hpd::model::{Drive, DriveConfig, Output};
 use drivespec_hpd::params::Target;
 use drivespec_hpd::{decode, parse, AckEnd, Data, FrameRules, Message, MessageKind, Status};
+use drivespec_link::Micros;
 use drivespec_sim::SimDevice;
-use drivespec_spec::{FamilyId, Readings, Spec};
-use std::sync::OnceLock;
-
-/// The built-in spec, loaded once.
-pub fn spec() -> &'static Spec {
-    static SPEC: OnceLock<Spec> = OnceLock::new();
-    SPEC.get_or_init(|| Spec::builtin().unwrap())
-}
+use drivespec_spec::{FamilyId, Readings};
 
 fn rules() -> FrameRules {
     FrameRules::from_spec(spec()).unwrap()

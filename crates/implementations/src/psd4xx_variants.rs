@@ -2,8 +2,8 @@
 //! choice to the implementation (4.3 fixes maxima of acceleration and deceleration, not a
 //! profile; chapter 3 fixes no reaction time), as a second team's drive would behave.
 
-use super::mutants::spec;
-use drivespec_conform::cyclic::{CyclicDevice, Env};
+use crate::spec;
+use drivespec_cyclic::{CyclicDevice, Env};
 use drivespec_positioner::Micros;
 use drivespec_psd4xx::model::{Drive, DriveConfig, RecordAnswer, RecordFailure, RecordRequest};
 use drivespec_psd4xx::{Input, Output, PkwResponse, Request, Width};
@@ -37,7 +37,11 @@ pub enum Kind {
 /// How the shaft follows the drive's trapezoid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Filter {
-    /// The mean over this many bus cycles: an S-curve (jerk-limited, never above the ramps).
+    /// The mean over this many bus cycles: an S-curve. The trapezoid averaged over a window
+    /// of T is the jerk-limited profile whose acceleration rises to the maximum of par 38/39
+    /// in T and falls back in T (jerk = maximum / T), never above it, and ends at the same
+    /// position without overshoot (the smoothing filter servo drives put behind their
+    /// trapezoid generator).
     Mean(usize),
     /// A first-order lag with this time constant (µs): a braking tail of its own.
     Lag(Micros),

@@ -2,10 +2,8 @@
 //! `psx3xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
 //! test (`psx3xx_mutants.rs`) and the fuzzer test (`crates/fuzz/tests/fuzz_psx3xx.rs`).
 
-use super::mutants::spec;
-use drivespec_conform::cyclic::{CyclicDevice, Env, Reply};
-use drivespec_conform::psx3xx::Psx3xxSuite;
-use drivespec_conform::suite::Settings;
+use crate::spec;
+use drivespec_cyclic::{CyclicDevice, Env, Reply};
 use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::{Request, Target, Value};
 use drivespec_psx3xx::model::Drive;
@@ -127,9 +125,9 @@ fn error_name(
 
 impl Mutant<'static> {
     pub fn new(kind: Kind) -> Mutant<'static> {
-        let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+        let reference = drivespec_sim::reference::psx3xx(spec(), None).unwrap();
         Mutant {
-            drive: suite.reference().clone(),
+            drive: reference.drive,
             kind,
             armed: None,
             last_stamp: None,

@@ -2,11 +2,11 @@
 //! operating modes or the status it reports about them (manual 3.3, 3.6), for the
 //! `hpd/motion` checks (`hpd_mutants.rs`).
 
-use super::mutants::spec;
-use drivespec_conform::link::Micros;
+use crate::spec;
 use drivespec_hpd::model::{Drive, DriveConfig, MotionStyle, Output};
 use drivespec_hpd::params::Target;
 use drivespec_hpd::{parse, Data, FrameRules, Message};
+use drivespec_link::Micros;
 use drivespec_sim::SimDevice;
 use drivespec_spec::FamilyId;
 

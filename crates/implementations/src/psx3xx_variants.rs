@@ -3,10 +3,8 @@
 //! values as examples and lets a save take up to 2000 ms), as a second team's drive would
 //! behave.
 
-use super::mutants::spec;
-use drivespec_conform::cyclic::{CyclicDevice, Env, Reply};
-use drivespec_conform::psx3xx::Psx3xxSuite;
-use drivespec_conform::suite::Settings;
+use crate::spec;
+use drivespec_cyclic::{CyclicDevice, Env, Reply};
 use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::Request;
 use drivespec_psx3xx::model::Drive;
@@ -47,9 +45,9 @@ pub struct Variant<'s> {
 impl Variant<'static> {
     /// The variant `kind`.
     pub fn new(kind: Kind) -> Variant<'static> {
-        let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+        let reference = drivespec_sim::reference::psx3xx(spec(), None).unwrap();
         Variant {
-            drive: suite.reference().clone(),
+            drive: reference.drive,
             kind,
             applied: None,
             pending: VecDeque::new(),

@@ -2,8 +2,8 @@
 //! `psd4xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
 //! test (`psd4xx_mutants.rs`) and the fuzzer test (`crates/fuzz/tests/fuzz_psd4xx.rs`).
 
-use super::mutants::spec;
-use drivespec_conform::cyclic::{CyclicDevice, Env};
+use crate::spec;
+use drivespec_cyclic::{CyclicDevice, Env};
 use drivespec_positioner::Micros;
 use drivespec_psd4xx::model::{Drive, RecordAnswer, RecordFailure, RecordRequest};
 use drivespec_psd4xx::{Input, Output, PkwRequest, Request};

@@ -9,9 +9,9 @@
 //!   allow (3.3: the ramps are limits; 3.6.4: the profile start is "not generated on a
 //!   constant time base").
 
-use super::mutants::spec;
-use drivespec_conform::link::Micros;
+use crate::spec;
 use drivespec_hpd::model::{Drive, DriveConfig, MotionStyle, Output};
+use drivespec_link::Micros;
 use drivespec_sim::SimDevice;
 use drivespec_spec::{FamilyId, Readings};
 

@@ -1,0 +1,44 @@
+//! `drivespec-impl FAMILY NAME`: serves one legal variant or violation mutant on stdin/stdout
+//! (an `exec:` device under test); `drivespec-impl FAMILY` lists the names, variants first.
+
+use drivespec_implementations::catalogue::{names, Side};
+use drivespec_implementations::serve::serve_stdio;
+use drivespec_spec::FamilyId;
+use std::process::ExitCode;
+use std::time::Duration;
+
+/// A served implementation stops by itself after this long (a runner that died leaves none).
+const TIME_LIMIT: Duration = Duration::from_secs(900);
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let family = args.first().and_then(|f| FamilyId::parse(f));
+    match (family, args.get(1)) {
+        (Some(family), None) => {
+            for side in [Side::Variant, Side::Mutant] {
+                for n in names(family, side) {
+                    println!(
+                        "{}\t{n}",
+                        if side == Side::Variant {
+                            "variant"
+                        } else {
+                            "mutant"
+                        }
+                    );
+                }
+            }
+            ExitCode::SUCCESS
+        }
+        (Some(family), Some(name)) => match serve_stdio(family, name, TIME_LIMIT) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("drivespec-impl: {e}");
+                ExitCode::from(2)
+            }
+        },
+        (None, _) => {
+            eprintln!("usage: drivespec-impl hpd|psd4xx|psx3xx [NAME]");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,44 @@
+//! Implementations of the three drive families as other teams could write them from the
+//! manuals, to measure the conformance suite from both sides:
+//!
+//! - legal variants ([`hpd_variants`], [`psd4xx_variants`], [`psx3xx_variants`]): they
+//!   differ from the reference only where the manual leaves the choice, and must pass every
+//!   case;
+//! - violation mutants ([`hpd_mutants`], [`psd4xx_mutants`], [`psx3xx_mutants`]): each
+//!   breaks the manual in one planted way, and must fail, naming the requirement it breaks.
+//!
+//! [`catalogue`] names them all; [`serve`] serves one on stdin/stdout with the protocol of its
+//! family (the HPD serial line, `drivespec-cyclic/1`), which the binary `drivespec-impl`
+//! does, so each runs as an `exec:` device under test too. The conformance tests
+//! (`crates/conform/tests/*_variants.rs`, `*_mutants.rs`) run them in-process, the fuzzer's
+//! tests run the mutants, and `tests/variants_exec.rs` runs them over `exec:`.
+//!
+//! These are test fixtures, not a library for users (unpublished): they are built from the
+//! built-in spec and end with a panic when it does not load.
+#![forbid(unsafe_code)]
+#![allow(
+    missing_docs,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+pub mod catalogue;
+pub mod hpd_motion_mutants;
+pub mod hpd_mutants;
+pub mod hpd_variants;
+pub mod psd4xx_mutants;
+pub mod psd4xx_variants;
+pub mod psx3xx_mutants;
+pub mod psx3xx_variants;
+pub mod serve;
+
+use drivespec_spec::Spec;
+use std::sync::OnceLock;
+
+/// The built-in spec, loaded once.
+pub fn spec() -> &'static Spec {
+    static SPEC: OnceLock<Spec> = OnceLock::new();
+    SPEC.get_or_init(|| Spec::builtin().unwrap())
+}
