@@ -655,12 +655,7 @@ pub fn suite_mutants() -> Vec<Case> {
             kind: Kind::LimitIntoMarginAccepted,
             name: "limits into the safety margins acknowledged",
             must_fail: &["psx3xx/position/measuring-range"],
-            breaks: &[
-                "PSX-POS-001",
-                "PSX-ISDU-129-RANGE",
-                "PSX-ISDU-130-RANGE",
-                "PSX-DP-ERR-004",
-            ],
+            breaks: &["PSX-POS-001", "PSX-MAP-005", "PSX-DP-ERR-004"],
         },
         Case {
             kind: Kind::StatusBytesSwapped,
