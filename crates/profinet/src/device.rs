@@ -546,20 +546,18 @@ impl Device {
             return;
         }
         match (class, h.service_id) {
-            (FrameClass::DcpIdentifyRequest, service::IDENTIFY) => {
-                if self.identify_matches(h) {
-                    let mut b = DcpBlocks::new();
-                    self.own_blocks(&mut b, true);
-                    let blocks = b.into_bytes();
-                    self.dcp_reply(
-                        src,
-                        FrameId::DCP_IDENTIFY_RES,
-                        service::IDENTIFY,
-                        service_type::SUCCESS,
-                        h.xid,
-                        &blocks,
-                    );
-                }
+            (FrameClass::DcpIdentifyRequest, service::IDENTIFY) if self.identify_matches(h) => {
+                let mut b = DcpBlocks::new();
+                self.own_blocks(&mut b, true);
+                let blocks = b.into_bytes();
+                self.dcp_reply(
+                    src,
+                    FrameId::DCP_IDENTIFY_RES,
+                    service::IDENTIFY,
+                    service_type::SUCCESS,
+                    h.xid,
+                    &blocks,
+                );
             }
             (FrameClass::DcpGetSet, service::GET) => {
                 let mut b = DcpBlocks::new();
@@ -1118,7 +1116,7 @@ impl Device {
         let fits = |list: &[(u16, u16, usize)], c: &IocrBlockReq, slot, subslot, len: usize| {
             list.iter()
                 .find(|o| o.0 == slot && o.1 == subslot)
-                .map(|o| o.2 + len + 1 <= usize::from(c.data_length))
+                .map(|o| o.2 + len < usize::from(c.data_length))
         };
         if fits(
             &in_objects,

@@ -35,5 +35,8 @@ mod station;
 pub mod status;
 pub mod udp;
 
+pub use controller::{
+    Controller, ControllerConfig, ControllerError, ControllerEvent, InputData, RecordId,
+};
 pub use device::{ArEnd, Device, DeviceConfig, DeviceError, DeviceEvent};
 pub use identity::{Identity, IdentityError};
