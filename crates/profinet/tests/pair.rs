@@ -1,0 +1,640 @@
+//! Controller and device in memory on a virtual clock: discovery, Connect, parameterisation,
+//! cyclic exchange that decodes as the manual says, records, refusals, the watchdog, link
+//! loss, Release; and the recorded exchange passes `drivespec check`.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing,
+    clippy::panic
+)]
+
+use drivespec_capture::dcerpc::PNIO_PORT;
+use drivespec_capture::link::ethertype;
+use drivespec_capture::pnio::PnioStatus;
+use drivespec_capture::profinet::Events;
+use drivespec_capture::rt::FrameId;
+use drivespec_capture::write::PcapWriter;
+use drivespec_capture::{CaptureReader, LinkType};
+use drivespec_check::profinet::{check, PnOptions};
+use drivespec_profinet::dcp::{self, opt, service, service_type, DcpBlocks};
+use drivespec_profinet::device::ArEnd;
+use drivespec_profinet::{
+    eth, Controller, ControllerConfig, ControllerError, ControllerEvent, Device, DeviceConfig,
+    DeviceEvent, Identity,
+};
+use drivespec_psd4xx::{Input, Output, RecordWrite, Reply, Request, Rules, Width};
+use drivespec_spec::Spec;
+use proptest::prelude::*;
+use std::sync::OnceLock;
+use std::time::Duration;
+
+const DEV_MAC: [u8; 6] = [0x00, 0x30, 0xDE, 0x42, 0x60, 0x17];
+const CTL_MAC: [u8; 6] = [0x00, 0x1B, 0x1B, 0x4A, 0x10, 0x01];
+const DEV_IP: [u8; 4] = [192, 168, 10, 26];
+const CTL_IP: [u8; 4] = [192, 168, 10, 1];
+const NAME: &str = "psd426-axis-x";
+/// 2026-01-01 in µs, the capture's time origin.
+const T0_US: u64 = 1_767_225_600_000_000;
+
+fn spec() -> &'static Spec {
+    static SPEC: OnceLock<Spec> = OnceLock::new();
+    SPEC.get_or_init(|| Spec::builtin().unwrap())
+}
+
+fn rules() -> Rules {
+    Rules::from_spec(spec()).unwrap()
+}
+
+fn device() -> Device {
+    let mut c = DeviceConfig::new(spec(), "PSD426", DEV_MAC, NAME).unwrap();
+    c.ip = DEV_IP;
+    c.netmask = [255, 255, 255, 0];
+    Device::new(spec(), c).unwrap()
+}
+
+fn controller_config() -> ControllerConfig {
+    ControllerConfig::new(Identity::from_spec(spec()).unwrap(), CTL_MAC, CTL_IP, NAME)
+}
+
+/// The two stations joined by a lossless wire, every frame recorded.
+struct Pair {
+    dev: Device,
+    ctl: Controller,
+    now: Duration,
+    frames: Vec<(Duration, Vec<u8>)>,
+    ctl_events: Vec<ControllerEvent>,
+    dev_events: Vec<DeviceEvent>,
+}
+
+impl Pair {
+    fn new(config: ControllerConfig) -> Pair {
+        let mut p = Pair {
+            dev: device(),
+            ctl: Controller::new(config),
+            now: Duration::ZERO,
+            frames: Vec::new(),
+            ctl_events: Vec::new(),
+            dev_events: Vec::new(),
+        };
+        p.ctl.start(p.now);
+        p
+    }
+
+    fn deliver(&mut self) {
+        loop {
+            let mut moved = false;
+            while let Some(f) = self.ctl.poll_transmit(self.now) {
+                self.dev.handle_frame(self.now, &f);
+                self.frames.push((self.now, f));
+                moved = true;
+            }
+            while let Some(f) = self.dev.poll_transmit(self.now) {
+                self.ctl.handle_frame(self.now, &f);
+                self.frames.push((self.now, f));
+                moved = true;
+            }
+            if !moved {
+                break;
+            }
+        }
+        self.ctl_events
+            .extend(std::iter::from_fn(|| self.ctl.poll_event()));
+        self.dev_events
+            .extend(std::iter::from_fn(|| self.dev.poll_event()));
+    }
+
+    /// One step: deliver what is due, then jump to the next wakeup.
+    fn step(&mut self) {
+        self.deliver();
+        let next = [self.dev.poll_timeout(), self.ctl.poll_timeout()]
+            .into_iter()
+            .flatten()
+            .min()
+            .unwrap_or(self.now + Duration::from_millis(1));
+        self.now = next.max(self.now + Duration::from_micros(1));
+        self.dev.handle_timeout(self.now);
+        self.ctl.handle_timeout(self.now);
+        self.deliver();
+    }
+
+    /// Steps until `done` or the virtual time `limit` passed.
+    fn run_until(&mut self, limit: Duration, done: impl Fn(&Pair) -> bool) -> bool {
+        while self.now < limit {
+            if done(self) {
+                return true;
+            }
+            self.step();
+        }
+        done(self)
+    }
+
+    fn run_for(&mut self, d: Duration) {
+        let end = self.now + d;
+        self.run_until(end, |_| false);
+    }
+
+    fn running(config: ControllerConfig) -> Pair {
+        let mut p = Pair::new(config);
+        assert!(
+            p.run_until(Duration::from_secs(5), |p| p.ctl.is_running()),
+            "{:?}",
+            p.ctl_events
+        );
+        p
+    }
+
+    fn input(&self) -> Input {
+        Input::parse(&rules(), &self.ctl.input().unwrap().image).unwrap()
+    }
+
+    fn record(&mut self, id: drivespec_profinet::RecordId) -> Result<Vec<u8>, ControllerError> {
+        let limit = self.now + Duration::from_secs(5);
+        let found = |p: &Pair| {
+            p.ctl_events.iter().find_map(|e| match e {
+                ControllerEvent::Record { id: i, result } if *i == id => Some(result.clone()),
+                _ => None,
+            })
+        };
+        self.run_until(limit, |p| found(p).is_some());
+        found(self).expect("record answered")
+    }
+
+    fn pcap(&self) -> Vec<u8> {
+        let mut w = PcapWriter::new(Vec::new(), LinkType::ETHERNET, 65535).unwrap();
+        for (t, f) in &self.frames {
+            w.write_packet(T0_US + t.as_micros() as u64, f).unwrap();
+        }
+        w.into_inner().unwrap()
+    }
+}
+
+fn output(pkw: Request, control: u16, target: i32) -> Vec<u8> {
+    let r = rules();
+    Output {
+        pkw: r.pkw().encode_request(&pkw).unwrap(),
+        control,
+        target,
+    }
+    .to_bytes(&r)
+    .unwrap()
+}
+
+#[test]
+fn a_controller_connects_exchanges_data_and_records_and_releases() {
+    let mut p = Pair::running(controller_config());
+    let id = Identity::from_spec(spec()).unwrap();
+    assert!(matches!(
+        p.ctl_events[0],
+        ControllerEvent::Identified { mac: DEV_MAC, ip: DEV_IP, id: Some((v, d)) } if v == id.vendor_id && d == id.device_id
+    ));
+    assert!(p.ctl_events.contains(&ControllerEvent::Connected));
+    assert!(p.dev_events.contains(&DeviceEvent::PrmEnd));
+    assert!(p.dev_events.contains(&DeviceEvent::Data));
+
+    // PKW read of par. 1 (3.8): answered with the status word.
+    let r = rules();
+    p.ctl.set_output(&output(
+        Request::Read {
+            pnu: 1,
+            index: None,
+        },
+        0,
+        0,
+    ));
+    p.run_for(Duration::from_millis(20));
+    let reply = r.pkw().reply(&p.input().pkw).unwrap();
+    assert!(matches!(reply, Reply::Value { pnu: 1, .. }), "{reply:?}");
+    let before = p.ctl.input_frames();
+
+    // A positioning run (4.1: control word 0x14 with the target; 3.7 bit 6 no loop).
+    let target = 800;
+    p.ctl.set_output(&output(Request::None, 0x54, target));
+    p.run_until(p.now + Duration::from_secs(20), |p| {
+        p.input().actual == target && p.input().status & 1 != 0
+    });
+    let input = p.input();
+    assert_eq!(input.actual, target, "the run reaches its target");
+    assert_eq!(
+        input.status & 1,
+        1,
+        "status bit 0: target position achieved (3.6)"
+    );
+    assert!(
+        p.ctl.input_frames() - before >= 1000,
+        "at least 1,000 cycles exchanged"
+    );
+    assert_eq!(p.dev.drive().outputs_in_force().target, target);
+
+    // Records (3.2.2): read par. 1, write par. 44, read it back; I&M0 on the DAP.
+    let (slot, sub) = (id.output.slot, id.output.subslot);
+    let rid = p.ctl.read_record(p.now, slot, sub, 1).unwrap();
+    assert_eq!(
+        p.record(rid).unwrap().len(),
+        2,
+        "16-bit values read as 2 bytes"
+    );
+    let data = RecordWrite {
+        index: 44,
+        control: 1,
+        width: Width::Word,
+        value: 7,
+    }
+    .to_bytes(r.record())
+    .unwrap();
+    let rid = p.ctl.write_record(p.now, slot, sub, 44, &data).unwrap();
+    assert_eq!(p.record(rid), Ok(Vec::new()));
+    assert_eq!(p.dev.drive().parameter(44), Ok(7));
+    let rid = p.ctl.read_record(p.now, id.dap_slot, 1, 0xAFF0).unwrap();
+    let im0 = p.record(rid).unwrap();
+    assert_eq!(&im0[..2], &[0x00, 0x20]);
+    assert_eq!(u16::from_be_bytes([im0[6], im0[7]]), id.vendor_id);
+
+    // Release: the AR ends and the drive's outputs become 0 (3.9).
+    p.ctl.release(p.now).unwrap();
+    p.run_until(p.now + Duration::from_secs(2), |p| p.ctl.is_closed());
+    assert!(p.ctl_events.contains(&ControllerEvent::Released));
+    assert!(p
+        .dev_events
+        .contains(&DeviceEvent::ArEnded(ArEnd::Released)));
+    assert_eq!(p.dev.drive().outputs_in_force().control, 0);
+    assert_eq!(p.dev.ar_state(), None);
+}
+
+#[test]
+fn the_recorded_exchange_passes_drivespec_check_and_finds_the_drive() {
+    let mut p = Pair::running(controller_config());
+    p.ctl.set_output(&output(
+        Request::Read {
+            pnu: 1,
+            index: None,
+        },
+        0,
+        0,
+    ));
+    p.run_for(Duration::from_millis(50));
+    p.ctl.set_output(&output(Request::None, 0x54, 400));
+    p.run_for(Duration::from_millis(400));
+    let id = Identity::from_spec(spec()).unwrap();
+    let rid = p
+        .ctl
+        .read_record(p.now, id.output.slot, id.output.subslot, 3)
+        .unwrap();
+    p.record(rid).unwrap();
+    p.run_for(Duration::from_millis(50));
+    p.ctl.release(p.now).unwrap();
+    p.run_until(p.now + Duration::from_secs(2), |p| p.ctl.is_closed());
+    let bytes = p.pcap();
+    let report = check(
+        spec(),
+        PnOptions::default(),
+        Events::new(CaptureReader::new(&bytes[..]).unwrap()),
+    )
+    .unwrap();
+    assert_eq!(report.violation_count, 0, "{:#?}", report.violations);
+    assert_eq!(report.drives.len(), 1, "{:#?}", report.notes);
+}
+
+#[test]
+fn an_unknown_record_index_is_refused_with_invalid_index() {
+    let mut p = Pair::running(controller_config());
+    let id = Identity::from_spec(spec()).unwrap();
+    let rid = p
+        .ctl
+        .read_record(p.now, id.output.slot, id.output.subslot, 0x7FFF)
+        .unwrap();
+    let want = PnioStatus {
+        code: 0xDE,
+        decode: 0x80,
+        code1: 0xB0,
+        code2: 0,
+    };
+    assert_eq!(
+        p.record(rid),
+        Err(ControllerError::Refused {
+            operation: "Read",
+            status: want
+        })
+    );
+    // A wrong write length (3.2.2: 3 bytes for a 16-bit value) is a write length error.
+    let rid = p
+        .ctl
+        .write_record(p.now, id.output.slot, id.output.subslot, 44, &[1, 0])
+        .unwrap();
+    let want = PnioStatus {
+        code: 0xDF,
+        decode: 0x80,
+        code1: 0xB1,
+        code2: 0,
+    };
+    assert_eq!(
+        p.record(rid),
+        Err(ControllerError::Refused {
+            operation: "Write",
+            status: want
+        })
+    );
+    // The AR goes on.
+    assert!(p.ctl.is_running());
+}
+
+#[test]
+fn a_wrong_module_ident_gives_a_module_diff_and_the_controller_refuses_it() {
+    let mut c = controller_config();
+    c.identity.output.module_ident = 0x0999;
+    let mut p = Pair::new(c);
+    p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+    let diff = p.ctl_events.iter().find_map(|e| match e {
+        ControllerEvent::Failed(ControllerError::ModuleDiff(d)) => Some(d.clone()),
+        _ => None,
+    });
+    let diff = diff.expect("a ModuleDiff failure");
+    let id = Identity::from_spec(spec()).unwrap();
+    assert_eq!(diff.len(), 1);
+    assert_eq!(
+        (diff[0].slot, diff[0].ident, diff[0].state),
+        (id.output.slot, id.output.module_ident, 1)
+    );
+    assert!(matches!(
+        p.dev_events[0],
+        DeviceEvent::Connected { diff: true, .. }
+    ));
+    // The controller released the AR it did not want.
+    p.run_for(Duration::from_millis(10));
+    assert_eq!(p.dev.ar_state(), None);
+}
+
+#[test]
+fn wrong_module_lengths_refuse_the_connect_with_the_faulty_field() {
+    let mut c = controller_config();
+    c.identity.output.length = 12;
+    let mut p = Pair::new(c);
+    p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+    let want = PnioStatus {
+        code: 0xDB,
+        decode: 0x81,
+        code1: 0x03,
+        code2: 14,
+    };
+    assert!(
+        p.ctl_events
+            .contains(&ControllerEvent::Failed(ControllerError::Refused {
+                operation: "Connect",
+                status: want
+            })),
+        "{:?}",
+        p.ctl_events
+    );
+    assert_eq!(p.dev.ar_state(), None);
+}
+
+#[test]
+fn a_send_clock_out_of_range_is_refused() {
+    for (scf, rr, field) in [(9, 1, 10), (32, 3, 11), (65524, 1, 10)] {
+        let mut c = controller_config();
+        c.send_clock_factor = scf;
+        c.reduction_ratio = rr;
+        let mut p = Pair::new(c);
+        p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+        let want = PnioStatus {
+            code: 0xDB,
+            decode: 0x81,
+            code1: 0x02,
+            code2: field,
+        };
+        assert!(
+            p.ctl_events
+                .contains(&ControllerEvent::Failed(ControllerError::Refused {
+                    operation: "Connect",
+                    status: want
+                })),
+            "SCF {scf} RR {rr}: {:?}",
+            p.ctl_events
+        );
+    }
+}
+
+#[test]
+fn the_watchdog_ends_the_ar_when_the_controller_stops_sending() {
+    let mut p = Pair::running(controller_config());
+    p.ctl.set_output(&output(Request::None, 0x54, 4000));
+    p.run_for(Duration::from_millis(50));
+    assert!(p.dev.drive().outputs_in_force().control != 0);
+    p.ctl.set_sending(false);
+    p.run_until(p.now + Duration::from_secs(1), |p| p.ctl.is_closed());
+    assert!(
+        p.dev_events
+            .contains(&DeviceEvent::ArEnded(ArEnd::Watchdog)),
+        "{:?}",
+        p.dev_events
+    );
+    let abort = PnioStatus {
+        code: 0xCF,
+        decode: 0x81,
+        code1: 0xFD,
+        code2: 0x05,
+    };
+    assert!(
+        p.ctl_events
+            .contains(&ControllerEvent::Failed(ControllerError::Aborted(abort))),
+        "{:?}",
+        p.ctl_events
+    );
+    // Manual 3.9: the connection is lost, the outputs become 0.
+    assert_eq!(p.dev.drive().outputs_in_force().control, 0);
+}
+
+#[test]
+fn link_loss_zeroes_the_outputs_and_the_controller_sees_its_watchdog() {
+    let mut p = Pair::running(controller_config());
+    p.ctl.set_output(&output(Request::None, 0x54, 4000));
+    p.run_for(Duration::from_millis(50));
+    p.dev.handle_link(p.now, false);
+    assert_eq!(p.dev.drive().outputs_in_force().control, 0);
+    p.run_until(p.now + Duration::from_secs(1), |p| p.ctl.is_closed());
+    assert!(matches!(
+        p.ctl_events.last(),
+        Some(ControllerEvent::Failed(ControllerError::Watchdog(_)))
+    ));
+    assert!(p
+        .dev_events
+        .contains(&DeviceEvent::ArEnded(ArEnd::LinkDown)));
+}
+
+#[test]
+fn bad_iops_keeps_the_last_outputs() {
+    let mut p = Pair::running(controller_config());
+    p.ctl.set_output(&output(Request::None, 0x54, 4000));
+    p.run_for(Duration::from_millis(20));
+    // A frame with the output module's IOPS bad (controller CPU in STOP, 3.9 item 1).
+    let mut c = controller_config();
+    c.identity = Identity::from_spec(spec()).unwrap();
+    let in_force = *p.dev.drive().outputs_in_force();
+    let stop_frame = {
+        let (_, last) = p
+            .frames
+            .iter()
+            .rev()
+            .find(|(_, f)| {
+                f.get(..6) == Some(&DEV_MAC[..])
+                    && f.get(12..14) == Some(&[0x88, 0x92][..])
+                    && f[14] == 0xC1
+            })
+            .unwrap()
+            .clone();
+        let mut f = last;
+        let dap = c.identity.dap_submodules.len();
+        let iops_at = 16 + dap + 1 + 14;
+        f[iops_at] = 0x00;
+        // Output image with control 0 in the same frame: it must not be applied.
+        for b in &mut f[16 + dap + 1 + 8..16 + dap + 1 + 10] {
+            *b = 0;
+        }
+        f
+    };
+    p.ctl.set_sending(false);
+    p.dev.handle_frame(p.now, &stop_frame);
+    assert_eq!(*p.dev.drive().outputs_in_force(), in_force);
+}
+
+#[test]
+fn an_absent_station_ends_in_no_such_station() {
+    let mut c = controller_config();
+    c.target = "nobody-here".into();
+    let mut p = Pair::new(c);
+    p.run_until(Duration::from_secs(30), |p| p.ctl.is_closed());
+    assert_eq!(
+        p.ctl_events.last(),
+        Some(&ControllerEvent::Failed(ControllerError::NoSuchStation(
+            "nobody-here".into()
+        )))
+    );
+}
+
+#[test]
+fn a_device_without_ip_gets_one_by_dcp_set() {
+    let mut c = DeviceConfig::new(spec(), "PSD426", DEV_MAC, NAME).unwrap();
+    c.ip = [0; 4];
+    let mut cc = controller_config();
+    cc.device_ip = Some((DEV_IP, [255, 255, 255, 0], [0; 4]));
+    let mut p = Pair::new(cc);
+    p.dev = Device::new(spec(), c).unwrap();
+    assert!(
+        p.run_until(Duration::from_secs(10), |p| p.ctl.is_running()),
+        "{:?}",
+        p.ctl_events
+    );
+    assert_eq!(p.dev.ip(), DEV_IP);
+    assert!(p.dev_events.contains(&DeviceEvent::IpSet(DEV_IP)));
+}
+
+#[test]
+fn dcp_set_name_and_identify_all() {
+    let mut d = device();
+    let mut b = DcpBlocks::new();
+    b.with_info(opt::NAME_OF_STATION, dcp::PERMANENT, b"psd-07");
+    let pdu = dcp::pdu(
+        FrameId::DCP_GET_SET,
+        service::SET,
+        service_type::REQUEST,
+        9,
+        0,
+        &b.into_bytes(),
+    );
+    d.handle_frame(
+        Duration::ZERO,
+        &eth::frame(DEV_MAC, CTL_MAC, None, ethertype::PROFINET, &pdu),
+    );
+    assert_eq!(d.station_name(), "psd-07");
+    let res = d.poll_transmit(Duration::ZERO).unwrap();
+    assert_eq!(&res[..6], &CTL_MAC);
+    let mut b = DcpBlocks::new();
+    b.plain(opt::ALL, &[]);
+    let pdu = dcp::pdu(
+        FrameId::DCP_IDENTIFY_REQ,
+        service::IDENTIFY,
+        service_type::REQUEST,
+        10,
+        1,
+        &b.into_bytes(),
+    );
+    d.handle_frame(
+        Duration::ZERO,
+        &eth::frame(
+            eth::DCP_IDENTIFY_MAC,
+            CTL_MAC,
+            None,
+            ethertype::PROFINET,
+            &pdu,
+        ),
+    );
+    let res = d.poll_transmit(Duration::ZERO).unwrap();
+    assert!(res.windows(6).any(|w| w == b"psd-07"));
+    // Identify for another name: no answer.
+    let mut b = DcpBlocks::new();
+    b.plain(opt::NAME_OF_STATION, b"other");
+    let pdu = dcp::pdu(
+        FrameId::DCP_IDENTIFY_REQ,
+        service::IDENTIFY,
+        service_type::REQUEST,
+        11,
+        1,
+        &b.into_bytes(),
+    );
+    d.handle_frame(
+        Duration::ZERO,
+        &eth::frame(
+            eth::DCP_IDENTIFY_MAC,
+            CTL_MAC,
+            None,
+            ethertype::PROFINET,
+            &pdu,
+        ),
+    );
+    assert_eq!(d.poll_transmit(Duration::ZERO), None);
+}
+
+fn prefixed() -> impl Strategy<Value = Vec<u8>> {
+    let pn = {
+        let mut h = DEV_MAC.to_vec();
+        h.extend_from_slice(&CTL_MAC);
+        h.extend_from_slice(&[0x88, 0x92]);
+        h
+    };
+    let udp = {
+        let mut h = DEV_MAC.to_vec();
+        h.extend_from_slice(&CTL_MAC);
+        h.extend_from_slice(&[0x08, 0x00, 0x45, 0, 0, 0xFF, 0, 0, 0, 0, 64, 17, 0, 0]);
+        h.extend_from_slice(&CTL_IP);
+        h.extend_from_slice(&DEV_IP);
+        h.extend_from_slice(&[0xC0, 0x01]);
+        h.extend_from_slice(&PNIO_PORT.to_be_bytes());
+        h.extend_from_slice(&[0, 0xEB, 0, 0, 4, 0]);
+        h
+    };
+    (0usize..3, proptest::collection::vec(any::<u8>(), 0..300)).prop_map(move |(k, tail)| {
+        let mut f = match k {
+            0 => pn.clone(),
+            1 => udp.clone(),
+            _ => Vec::new(),
+        };
+        f.extend_from_slice(&tail);
+        f
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+    #[test]
+    fn arbitrary_frames_never_panic_a_device_or_a_controller(frames in proptest::collection::vec(prefixed(), 1..8)) {
+        let mut d = device();
+        let mut c = Controller::new(controller_config());
+        c.start(Duration::ZERO);
+        for (i, f) in frames.iter().enumerate() {
+            let t = Duration::from_millis(i as u64);
+            d.handle_frame(t, f);
+            c.handle_frame(t, f);
+            while d.poll_transmit(t).is_some() {}
+            while c.poll_transmit(t).is_some() {}
+        }
+    }
+}
