@@ -264,7 +264,7 @@ struct Layout {
 }
 
 /// A PROFINET IO controller for one PSD4xx (our doc: module `controller`).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Controller {
     config: ControllerConfig,
     state: State,
@@ -275,6 +275,7 @@ pub struct Controller {
     calls: VecDeque<Call>,
     sequence: u32,
     next_record: u64,
+    record_seq: u16,
     ip_id: u16,
     cyclic: bool,
     sending: bool,
@@ -315,6 +316,7 @@ impl Controller {
             calls: VecDeque::new(),
             sequence: 0,
             next_record: 0,
+            record_seq: 0,
             ip_id: 0,
             cyclic: false,
             sending: true,
@@ -869,7 +871,8 @@ impl Controller {
         index: u16,
         data: Option<&[u8]>,
     ) -> Vec<u8> {
-        let seq = u16::try_from(self.sequence & 0xFFFF).unwrap_or(0);
+        let seq = self.record_seq;
+        self.record_seq = self.record_seq.wrapping_add(1);
         let req = RecordRequest {
             header: header(if data.is_some() {
                 block_type::WRITE_REQ

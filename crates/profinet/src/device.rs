@@ -201,6 +201,8 @@ struct OutputCr {
     offset: usize,
     hold: Duration,
     deadline: Duration,
+    /// A valid frame arrived (the DataHoldFactor watchdog runs).
+    seen: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -228,7 +230,7 @@ const MAX_ALARM_DATA: u16 = 200;
 const OUTPUT_FRAME_ID: FrameId = FrameId(0xC100);
 
 /// A PSD4xx reference drive behind a PROFINET IO device (our doc: module `device`).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Device {
     config: DeviceConfig,
     drive: Drive,
@@ -424,7 +426,12 @@ impl Device {
             return;
         }
         if now >= ar.output.deadline {
-            self.end_ar(ArEnd::Watchdog, Some(status::abort(code2::DHT_EXPIRED)));
+            let (end, reason) = if ar.output.seen {
+                (ArEnd::Watchdog, code2::DHT_EXPIRED)
+            } else {
+                (ArEnd::CmiTimeout, code2::CMI_TIMEOUT)
+            };
+            self.end_ar(end, Some(status::abort(reason)));
             return;
         }
         if let Phase::AppReady { next, deadline } = ar.phase {
@@ -760,6 +767,7 @@ impl Device {
             return;
         };
         ar.output.deadline = now + ar.output.hold;
+        ar.output.seen = true;
         if ar.phase != Phase::Data || !ar.psd_ok {
             return;
         }
@@ -1156,15 +1164,15 @@ impl Device {
         let in_period = cycle(input.send_clock_factor, input.reduction_ratio);
         let out_period = cycle(output.send_clock_factor, output.reduction_ratio);
         let hold = out_period * u32::from(output.data_hold_factor);
+        let activity_timeout =
+            Duration::from_millis(100 * u64::from(ar.activity_timeout_factor.max(1)));
         let ar_block = Ar {
             uuid: ar.ar_uuid,
             session_key: ar.session_key,
             controller: src,
             controller_ip: ep.src,
             controller_object: ar.initiator_object,
-            activity_timeout: Duration::from_millis(
-                100 * u64::from(ar.activity_timeout_factor.max(1)),
-            ),
+            activity_timeout,
             input: InputCr {
                 frame_id: input.frame_id,
                 data_length: usize::from(input.data_length),
@@ -1178,7 +1186,10 @@ impl Device {
                 data_length: usize::from(output.data_length),
                 offset: out_offset,
                 hold,
-                deadline: now + hold,
+                // Until the first frame arrives the AR waits for the controller's activity
+                // timeout; from then on DataHoldFactor cycles (IEC 61158-6-10 DHT).
+                deadline: now + activity_timeout,
+                seen: false,
             },
             alarm_remote: alarm.local_alarm_reference,
             phase: Phase::WaitPrmEnd,

@@ -64,6 +64,8 @@ struct Pair {
     frames: Vec<(Duration, Vec<u8>)>,
     ctl_events: Vec<ControllerEvent>,
     dev_events: Vec<DeviceEvent>,
+    /// Drop the device's IPv4 frames (a device that never answers PNIO-CM).
+    silent_udp: bool,
 }
 
 impl Pair {
@@ -75,6 +77,7 @@ impl Pair {
             frames: Vec::new(),
             ctl_events: Vec::new(),
             dev_events: Vec::new(),
+            silent_udp: false,
         };
         p.ctl.start(p.now);
         p
@@ -89,6 +92,9 @@ impl Pair {
                 moved = true;
             }
             while let Some(f) = self.dev.poll_transmit(self.now) {
+                if self.silent_udp && f.get(12..14) == Some(&[0x08, 0x00][..]) {
+                    continue;
+                }
                 self.ctl.handle_frame(self.now, &f);
                 self.frames.push((self.now, f));
                 moved = true;
@@ -636,5 +642,69 @@ proptest! {
             while d.poll_transmit(t).is_some() {}
             while c.poll_transmit(t).is_some() {}
         }
+    }
+}
+
+#[test]
+fn a_connect_without_answer_times_out_after_its_repeats() {
+    let mut p = Pair::new(controller_config());
+    p.silent_udp = true;
+    p.run_until(Duration::from_secs(10), |p| p.ctl.is_closed());
+    let connects = p
+        .frames
+        .iter()
+        .filter(|(_, f)| {
+            f.get(..6) == Some(&DEV_MAC[..]) && f.get(12..14) == Some(&[0x08, 0x00][..])
+        })
+        .count();
+    assert_eq!(connects, 4, "the Connect and its 3 repeats");
+    assert_eq!(
+        p.ctl_events.last(),
+        Some(&ControllerEvent::Failed(ControllerError::Timeout(
+            "Connect"
+        )))
+    );
+}
+
+/// The frames of a whole session, and a device in data exchange.
+fn session() -> &'static (Vec<Vec<u8>>, Device) {
+    static S: OnceLock<(Vec<Vec<u8>>, Device)> = OnceLock::new();
+    S.get_or_init(|| {
+        let mut p = Pair::running(controller_config());
+        let id = Identity::from_spec(spec()).unwrap();
+        let rid = p
+            .ctl
+            .read_record(p.now, id.output.slot, id.output.subslot, 1)
+            .unwrap();
+        p.record(rid).unwrap();
+        p.run_for(Duration::from_millis(5));
+        let dev = p.dev.clone();
+        p.ctl.release(p.now).unwrap();
+        p.run_until(p.now + Duration::from_secs(2), |p| p.ctl.is_closed());
+        (p.frames.into_iter().map(|(_, f)| f).collect(), dev)
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+    #[test]
+    fn mutated_session_frames_never_panic_a_running_device(
+        pick in any::<prop::sample::Index>(),
+        flips in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6),
+        cut in any::<prop::sample::Index>(),
+    ) {
+        let (frames, dev) = session();
+        let mut f = pick.get(frames).clone();
+        for (at, v) in &flips {
+            let i = at.index(f.len());
+            f[i] ^= v | 1;
+        }
+        f.truncate(cut.index(f.len() + 1).max(1));
+        let mut d = dev.clone();
+        let t = Duration::from_secs(1);
+        d.handle_frame(t, &f);
+        while d.poll_transmit(t).is_some() {}
+        d.handle_timeout(t + Duration::from_millis(100));
+        while d.poll_transmit(t + Duration::from_millis(100)).is_some() {}
     }
 }

@@ -535,7 +535,7 @@ pub enum LedPattern {
 
 /// The PROFINET identity of the device: what DCP answers, what a Connect expects and what
 /// the GSDML declares (manual 2.1, 3.2.1; the numbers are drivespec's own, see `source`).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PnIdentity {
     /// Where the numbers come from.
@@ -562,7 +562,7 @@ pub struct PnIdentity {
 
 /// The device access point (IEC 61158-6-10: slot 0, subslot 1 and the interface and port
 /// subslots 0x8000, 0x8001 …).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PnDap {
     /// Slot of the DAP.
@@ -574,7 +574,7 @@ pub struct PnDap {
 }
 
 /// One submodule without IO data (DAP, interface or port).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PnSubmodule {
     /// SubslotNumber.
@@ -586,7 +586,7 @@ pub struct PnSubmodule {
 }
 
 /// A module with one IO submodule (3.2.1).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PnModule {
     /// SlotNumber.
@@ -602,7 +602,7 @@ pub struct PnModule {
 }
 
 /// I&M0 fields (IEC 61158-6-10 "I&M0"; order id and serial number come from the model).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PnIm0 {
     /// IM_Hardware_Revision.
