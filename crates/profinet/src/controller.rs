@@ -24,8 +24,8 @@ use crate::udp::{Endpoints, Ipv4};
 use drivespec_capture::dcerpc::{Header, PacketType, Uuid, PNIO_PORT};
 use drivespec_capture::link::ethertype;
 use drivespec_capture::pnio::{
-    block_type, control_command, module_diff, AlarmCrBlockReq, ArBlockReq, Block, BlockHeader,
-    CmMessage, ControlBlock, ControlKind, DiffModule, Direction, FrameOffset, IocrApi,
+    alarm_cr_res, block_type, control_command, module_diff, AlarmCrBlockReq, ArBlockReq, Block,
+    BlockHeader, CmMessage, ControlBlock, ControlKind, DiffModule, Direction, FrameOffset, IocrApi,
     IocrBlockReq, Operation, PnioStatus, RecordRequest,
 };
 use drivespec_capture::rt::{DataStatus, DcpHeader, FrameClass, FrameId};
@@ -37,6 +37,9 @@ pub const MAX_QUEUED: usize = 256;
 
 /// The UDP port the controller's calls go out from.
 pub const CLIENT_PORT: u16 = 0xC001;
+
+/// The controller's LocalAlarmReference (IEC 61158-6-10 AlarmCRBlockReq).
+const ALARM_REF: u16 = 0x0003;
 
 /// FrameID the controller gives the input CR (IEC 61158-6-10 RT class 1: 0xC000–0xF7FF).
 pub const INPUT_FRAME_ID: FrameId = FrameId(0xC001);
@@ -276,6 +279,7 @@ pub struct Controller {
     sequence: u32,
     next_record: u64,
     record_seq: u16,
+    alarm_remote: Option<u16>,
     ip_id: u16,
     cyclic: bool,
     sending: bool,
@@ -317,6 +321,7 @@ impl Controller {
             sequence: 0,
             next_record: 0,
             record_seq: 0,
+            alarm_remote: None,
             ip_id: 0,
             cyclic: false,
             sending: true,
@@ -542,6 +547,22 @@ impl Controller {
             return;
         }
         self.state = State::Closed;
+        // An AR the device still holds is aborted with an ERR-RTA (IEC 61158-6-10): for a
+        // watchdog with its reason, for any other failure as an abort request.
+        let reason = match e {
+            ControllerError::Watchdog(_) => Some(status::code2::DHT_EXPIRED),
+            ControllerError::Aborted(_) | ControllerError::ModuleDiff(_) => None,
+            _ => Some(status::code2::ABORT_REQ),
+        };
+        if let (true, Some(reason), Some((dev, _)), Some(remote)) =
+            (self.cyclic, reason, self.device, self.alarm_remote)
+        {
+            let pdu = rt::abort(remote, ALARM_REF, status::abort(reason));
+            push(
+                &mut self.tx,
+                eth::frame(dev, self.config.mac, None, ethertype::PROFINET, &pdu),
+            );
+        }
         self.cyclic = false;
         for c in std::mem::take(&mut self.calls) {
             if let CallKind::Record(id, _) = c.kind {
@@ -841,7 +862,7 @@ impl Controller {
             properties: 0,
             rta_timeout_factor: 1,
             rta_retries: 3,
-            local_alarm_reference: 0x0003,
+            local_alarm_reference: ALARM_REF,
             max_alarm_data_length: 200,
             tag_header_high: 0xC000,
             tag_header_low: 0xA000,
@@ -1038,6 +1059,16 @@ impl Controller {
                     .flat_map(|d| d.modules)
                     .collect();
                 self.output_frame = out_frame;
+                self.alarm_remote = m
+                    .blocks
+                    .iter()
+                    .filter_map(|b| match b {
+                        Block::Unknown(u) => alarm_cr_res(u),
+                        _ => None,
+                    })
+                    .filter_map(Result::ok)
+                    .map(|a| a.local_alarm_reference)
+                    .next();
                 self.cyclic = true;
                 self.next_send = self.now;
                 self.input_deadline = Duration::MAX;

@@ -64,6 +64,8 @@ pub mod code2 {
     pub const DHT_EXPIRED: u8 = 0x05;
     /// RTA: AR CMI timeout.
     pub const CMI_TIMEOUT: u8 = 0x06;
+    /// RTA: abort request of the AR's user.
+    pub const ABORT_REQ: u8 = 0x0D;
     /// RTA: release indication received.
     pub const RELEASE_IND: u8 = 0x0F;
     /// RTA: link down.

@@ -64,8 +64,8 @@ struct Pair {
     frames: Vec<(Duration, Vec<u8>)>,
     ctl_events: Vec<ControllerEvent>,
     dev_events: Vec<DeviceEvent>,
-    /// Drop the device's IPv4 frames (a device that never answers PNIO-CM).
-    silent_udp: bool,
+    /// Device frames that are lost on the wire.
+    lost: fn(&[u8]) -> bool,
 }
 
 impl Pair {
@@ -77,7 +77,7 @@ impl Pair {
             frames: Vec::new(),
             ctl_events: Vec::new(),
             dev_events: Vec::new(),
-            silent_udp: false,
+            lost: |_| false,
         };
         p.ctl.start(p.now);
         p
@@ -92,7 +92,7 @@ impl Pair {
                 moved = true;
             }
             while let Some(f) = self.dev.poll_transmit(self.now) {
-                if self.silent_udp && f.get(12..14) == Some(&[0x08, 0x00][..]) {
+                if (self.lost)(&f) {
                     continue;
                 }
                 self.ctl.handle_frame(self.now, &f);
@@ -648,7 +648,7 @@ proptest! {
 #[test]
 fn a_connect_without_answer_times_out_after_its_repeats() {
     let mut p = Pair::new(controller_config());
-    p.silent_udp = true;
+    p.lost = |f| f.get(12..14) == Some(&[0x08, 0x00][..]);
     p.run_until(Duration::from_secs(10), |p| p.ctl.is_closed());
     let connects = p
         .frames
@@ -707,4 +707,71 @@ proptest! {
         d.handle_timeout(t + Duration::from_millis(100));
         while d.poll_transmit(t + Duration::from_millis(100)).is_some() {}
     }
+}
+
+#[test]
+fn the_controller_watchdog_aborts_the_ar_at_the_device() {
+    let mut p = Pair::running(controller_config());
+    p.run_for(Duration::from_millis(10));
+    // The device's frames stop reaching the controller.
+    p.lost = |_| true;
+    p.run_until(p.now + Duration::from_secs(1), |p| p.ctl.is_closed());
+    assert!(matches!(
+        p.ctl_events.last(),
+        Some(ControllerEvent::Failed(ControllerError::Watchdog(d))) if *d == Duration::from_millis(3)
+    ));
+    p.run_for(Duration::from_millis(5));
+    let abort = PnioStatus {
+        code: 0xCF,
+        decode: 0x81,
+        code1: 0xFD,
+        code2: 0x05,
+    };
+    assert!(
+        p.dev_events
+            .contains(&DeviceEvent::ArEnded(ArEnd::Aborted(abort))),
+        "{:?}",
+        p.dev_events
+    );
+}
+
+#[test]
+fn hello_and_get_answer_with_the_identity() {
+    let mut c = DeviceConfig::new(spec(), "PSD426", DEV_MAC, NAME).unwrap();
+    c.hello = true;
+    c.ip = DEV_IP;
+    let mut d = Device::new(spec(), c).unwrap();
+    let hello = d.poll_transmit(Duration::ZERO).unwrap();
+    assert_eq!(&hello[..6], &eth::DCP_HELLO_MAC);
+    assert_eq!(&hello[14..16], &[0xFE, 0xFC]);
+    assert!(hello.windows(NAME.len()).any(|w| w == NAME.as_bytes()));
+    // Get of DeviceID and an unsupported suboption.
+    let pdu = dcp::pdu(
+        FrameId::DCP_GET_SET,
+        service::GET,
+        service_type::REQUEST,
+        3,
+        0,
+        &[2, 3, 2, 9],
+    );
+    d.handle_frame(
+        Duration::ZERO,
+        &eth::frame(DEV_MAC, CTL_MAC, None, ethertype::PROFINET, &pdu),
+    );
+    let res = d.poll_transmit(Duration::ZERO).unwrap();
+    let id = Identity::from_spec(spec()).unwrap();
+    let l = drivespec_capture::link::parse_ethernet(&res).unwrap();
+    let h = drivespec_capture::rt::RtFrame::parse(l.payload)
+        .unwrap()
+        .dcp()
+        .unwrap();
+    let blocks: Vec<_> = h.iter_blocks().map(Result::unwrap).collect();
+    assert_eq!((blocks[0].option, blocks[0].suboption), opt::DEVICE_ID);
+    assert_eq!(&blocks[0].data[2..4], &id.vendor_id.to_be_bytes());
+    assert_eq!(&blocks[0].data[4..6], &id.device_id.to_be_bytes());
+    assert_eq!(
+        (blocks[1].option, blocks[1].suboption),
+        opt::CONTROL_RESPONSE
+    );
+    assert_eq!(blocks[1].data, &[2, 9, dcp::block_error::SUBOPTION][..]);
 }
