@@ -162,6 +162,9 @@ pub enum ControllerError {
     /// The request needs an AR in data exchange.
     #[error("no AR in data exchange")]
     NotRunning,
+    /// Too many requests wait already.
+    #[error("{MAX_QUEUED} requests wait already")]
+    Busy,
 }
 
 /// Identifies a record request (our doc: module `controller`).
@@ -929,6 +932,9 @@ impl Controller {
         self.advance(now);
         if self.state != State::Running {
             return Err(ControllerError::NotRunning);
+        }
+        if self.calls.len() >= MAX_QUEUED {
+            return Err(ControllerError::Busy);
         }
         let id = RecordId(self.next_record);
         self.next_record += 1;

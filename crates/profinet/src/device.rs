@@ -50,6 +50,12 @@ pub const MAX_QUEUED: usize = 256;
 /// Most answers kept to repeat for a repeated call (same activity and sequence).
 pub const MAX_CACHED: usize = 16;
 
+/// The reject status of an unknown interface (C706 appendix E: nca_unk_if).
+pub const NCA_UNK_IF: u32 = 0x1C01_0003;
+
+/// Most option pairs of one DCP Get answered (the answer stays within one frame).
+pub const MAX_GET: usize = 32;
+
 /// Record index of I&M0 (IEC 61158-6-10 "Index": 0xAFF0).
 pub const IM0_INDEX: u16 = 0xAFF0;
 
@@ -407,6 +413,25 @@ impl Device {
             } if dst == own && ep.dst == self.ip && station::has_ip(self.ip) => {
                 self.cm(now, src, ep, &header, &message)
             }
+            Incoming::OtherRpc {
+                src,
+                dst,
+                ep,
+                header,
+            } if dst == own
+                && ep.dst == self.ip
+                && ep.dst_port == PNIO_PORT
+                && header.ptype == PacketType::REQUEST =>
+            {
+                // C706 12.5.3.9: a call to an interface this server does not offer is
+                // rejected with nca_unk_if.
+                let mut h = rpc::response_header(&header, self.config.server_boot);
+                h.ptype = PacketType::REJECT;
+                let body = NCA_UNK_IF.to_le_bytes();
+                self.ip_id = self.ip_id.wrapping_add(1);
+                let f = station::rpc_frame(own, src, station::reply(ep), self.ip_id, &h, &body);
+                push(&mut self.tx, f);
+            }
             _ => {}
         }
     }
@@ -571,7 +596,7 @@ impl Device {
                 let mut full = DcpBlocks::new();
                 self.own_blocks(&mut full, true);
                 let full = full.into_bytes();
-                for pair in h.blocks.chunks_exact(2) {
+                for pair in h.blocks.chunks_exact(2).take(MAX_GET) {
                     let &[o, s] = pair else { continue };
                     let found = DcpHeader {
                         blocks: &full,

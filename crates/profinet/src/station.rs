@@ -62,6 +62,17 @@ pub(crate) enum Incoming<'a> {
         /// The RTA-PDU.
         alarm: AlarmHeader<'a>,
     },
+    /// A DCE/RPC PDU for another interface (e.g. the endpoint mapper).
+    OtherRpc {
+        /// Sender MAC.
+        src: Mac,
+        /// Destination MAC.
+        dst: Mac,
+        /// UDP endpoints as received.
+        ep: Endpoints,
+        /// The RPC header.
+        header: Header,
+    },
     /// A PNIO-CM call or answer (not fragmented).
     Cm {
         /// Sender MAC.
@@ -112,6 +123,19 @@ pub(crate) fn classify(frame: &[u8]) -> Option<Incoming<'_>> {
             let h = packet.header;
             if h.is_fragment() {
                 return None;
+            }
+            if !h.interface.is_pnio_interface() {
+                return Some(Incoming::OtherRpc {
+                    src,
+                    ep: Endpoints {
+                        src: udp.src,
+                        src_port: udp.src_port,
+                        dst: udp.dst,
+                        dst_port: udp.dst_port,
+                    },
+                    dst,
+                    header: h,
+                });
             }
             let message = pnio::decode_body(h.ptype, h.opnum, h.drep.integer, packet.body).ok()?;
             Some(Incoming::Cm {

@@ -775,3 +775,69 @@ fn hello_and_get_answer_with_the_identity() {
     );
     assert_eq!(blocks[1].data, &[2, 9, dcp::block_error::SUBOPTION][..]);
 }
+
+#[test]
+fn a_call_to_another_interface_is_rejected() {
+    use drivespec_capture::dcerpc::{self, PacketType, Uuid};
+    use drivespec_profinet::{rpc, udp};
+    let mut d = device();
+    // The endpoint mapper (C706 appendix L: E1AF8308-5D1F-11C9-91A4-08002B14A0FA).
+    let epm = Uuid([
+        0xE1, 0xAF, 0x83, 0x08, 0x5D, 0x1F, 0x11, 0xC9, 0x91, 0xA4, 0x08, 0x00, 0x2B, 0x14, 0xA0,
+        0xFA,
+    ]);
+    let h = rpc::request_header(Uuid::default(), epm, Uuid([7; 16]), 0, 2);
+    let ep = udp::Endpoints {
+        src: CTL_IP,
+        src_port: 0xC001,
+        dst: DEV_IP,
+        dst_port: PNIO_PORT,
+    };
+    let ip = udp::ipv4_udp(ep, 1, &rpc::encode(&h, &[0; 16]));
+    d.handle_frame(
+        Duration::ZERO,
+        &eth::frame(DEV_MAC, CTL_MAC, None, ethertype::IPV4, &ip),
+    );
+    let res = d.poll_transmit(Duration::ZERO).unwrap();
+    let l = drivespec_capture::link::parse_ethernet(&res).unwrap();
+    let u = drivespec_capture::ip::parse_ipv4_udp(l.payload).unwrap();
+    assert_eq!((u.dst, u.dst_port), (CTL_IP, 0xC001));
+    let p = dcerpc::parse(u.payload).unwrap();
+    assert_eq!(p.header.ptype, PacketType::REJECT);
+    assert_eq!(p.header.activity, Uuid([7; 16]));
+    assert_eq!(p.body, &0x1C01_0003u32.to_le_bytes()[..]);
+}
+
+#[test]
+fn records_need_the_ar_and_an_existing_subslot() {
+    let mut p = Pair::running(controller_config());
+    let rid = p.ctl.read_record(p.now, 9, 1, 1).unwrap();
+    let want = PnioStatus {
+        code: 0xDE,
+        decode: 0x80,
+        code1: 0xB2,
+        code2: 0,
+    };
+    assert_eq!(
+        p.record(rid),
+        Err(ControllerError::Refused {
+            operation: "Read",
+            status: want
+        })
+    );
+    // I&M0 cannot be written.
+    let rid = p.ctl.write_record(p.now, 0, 1, 0xAFF0, &[0; 4]).unwrap();
+    let want = PnioStatus {
+        code: 0xDF,
+        decode: 0x80,
+        code1: 0xB6,
+        code2: 0,
+    };
+    assert_eq!(
+        p.record(rid),
+        Err(ControllerError::Refused {
+            operation: "Write",
+            status: want
+        })
+    );
+}
