@@ -38,7 +38,7 @@ use drivespec_capture::pnio::{
 };
 use drivespec_capture::rt::{CyclicFrame, DcpHeader, FrameClass, FrameId};
 use drivespec_psd4xx::model::{
-    Drive, DriveConfig, LinkEvent, ModelError, RecordAnswer, RecordFailure,
+    Drive, DriveConfig, Event, LinkEvent, ModelError, RecordAnswer, RecordFailure,
     RecordRequest as DriveRecord,
 };
 use drivespec_spec::Spec;
@@ -442,8 +442,7 @@ impl Device {
         self.now = self.now.max(now);
         let now = self.now;
         self.drive.advance(micros(now));
-        while self.drive.poll_input().is_some() {}
-        while self.drive.poll_event().is_some() {}
+        self.drain_drive();
         let Some(ar) = self.ar.as_mut() else {
             return;
         };
@@ -468,6 +467,18 @@ impl Device {
                     deadline,
                 };
                 self.application_ready();
+            }
+        }
+    }
+
+    /// Drops the drive's input images (the cyclic frames read the current one) and follows
+    /// its events: par. 96 = -3 deletes the station name (manual 3.3, 2.1).
+    fn drain_drive(&mut self) {
+        while self.drive.poll_input().is_some() {}
+        while let Some((_, e)) = self.drive.poll_event() {
+            if e == Event::StationNameCleared && !self.name.is_empty() {
+                self.name.clear();
+                push(&mut self.events, DeviceEvent::NameSet(String::new()));
             }
         }
     }
@@ -815,6 +826,7 @@ impl Device {
         }
         if good {
             let _ = self.drive.handle_image(micros(now), image);
+            self.drain_drive();
         }
     }
 
@@ -1281,6 +1293,7 @@ impl Device {
         while let Some(r) = self.drive.poll_record() {
             last = Some(r.result);
         }
+        self.drain_drive();
         last
     }
 

@@ -841,3 +841,24 @@ fn records_need_the_ar_and_an_existing_subslot() {
         })
     );
 }
+
+#[test]
+fn par_96_minus_3_deletes_the_station_name() {
+    let mut p = Pair::running(controller_config());
+    let id = Identity::from_spec(spec()).unwrap();
+    let data = RecordWrite {
+        index: 96,
+        control: 1,
+        width: Width::Word,
+        value: -3,
+    }
+    .to_bytes(rules().record())
+    .unwrap();
+    let rid = p
+        .ctl
+        .write_record(p.now, id.output.slot, id.output.subslot, 96, &data)
+        .unwrap();
+    assert_eq!(p.record(rid), Ok(Vec::new()));
+    assert_eq!(p.dev.station_name(), "");
+    assert!(p.dev_events.contains(&DeviceEvent::NameSet(String::new())));
+}
