@@ -862,3 +862,59 @@ fn par_96_minus_3_deletes_the_station_name() {
     assert_eq!(p.dev.station_name(), "");
     assert!(p.dev_events.contains(&DeviceEvent::NameSet(String::new())));
 }
+
+#[test]
+fn parameter_records_are_written_before_prm_end() {
+    let mut c = controller_config();
+    let data = RecordWrite {
+        index: 44,
+        control: 1,
+        width: Width::Word,
+        value: 9,
+    }
+    .to_bytes(rules().record())
+    .unwrap();
+    // Control byte 0: the drive ignores the write (3.2.2).
+    let ignored = RecordWrite {
+        index: 45,
+        control: 0,
+        width: Width::Dword,
+        value: 123,
+    }
+    .to_bytes(rules().record())
+    .unwrap();
+    c.prm_records = vec![(44, data), (45, ignored)];
+    let before = device().drive().parameter(45);
+    let p = Pair::running(c);
+    assert_eq!(p.dev.drive().parameter(44), Ok(9));
+    assert_eq!(p.dev.drive().parameter(45), before);
+    let prm_end = p
+        .dev_events
+        .iter()
+        .position(|e| *e == DeviceEvent::PrmEnd)
+        .unwrap();
+    assert!(prm_end > 0);
+}
+
+#[test]
+fn a_refused_parameter_record_stops_the_start_up() {
+    let mut c = controller_config();
+    c.prm_records = vec![(0x7FFF, vec![1, 0, 0])];
+    let mut p = Pair::new(c);
+    p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+    let want = PnioStatus {
+        code: 0xDF,
+        decode: 0x80,
+        code1: 0xB0,
+        code2: 0,
+    };
+    assert!(
+        p.ctl_events.iter().any(|e| matches!(
+            e,
+            ControllerEvent::Failed(ControllerError::Refused { status, .. }) if *status == want
+        )),
+        "{:?}",
+        p.ctl_events
+    );
+    assert!(!p.dev_events.contains(&DeviceEvent::PrmEnd));
+}
