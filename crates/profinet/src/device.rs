@@ -106,6 +106,16 @@ pub struct DeviceConfig {
     pub hello: bool,
     /// Server boot time in the RPC headers.
     pub server_boot: u32,
+    /// A planted fault, for testing fuzzers and checkers against a wrong device.
+    pub fault: Option<Fault>,
+}
+
+/// A deliberate deviation a device can be built with (our doc: module `device`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Fault {
+    /// After an Identify request whose blocks do not parse, DCP is never answered again.
+    DcpDeafAfterMalformedIdentify,
 }
 
 impl DeviceConfig {
@@ -129,6 +139,7 @@ impl DeviceConfig {
             drive,
             hello: false,
             server_boot: 1,
+            fault: None,
         })
     }
 }
@@ -251,6 +262,7 @@ pub struct Device {
     cache: VecDeque<((Uuid, u32), Vec<u8>)>,
     ip_id: u16,
     now: Duration,
+    dcp_deaf: bool,
 }
 
 fn push<T>(q: &mut VecDeque<T>, v: T) {
@@ -278,6 +290,7 @@ impl Device {
             cache: VecDeque::new(),
             ip_id: 0,
             now: Duration::ZERO,
+            dcp_deaf: false,
         };
         if d.config.hello {
             d.hello();
@@ -585,7 +598,14 @@ impl Device {
     }
 
     fn dcp(&mut self, src: Mac, class: FrameClass, h: &DcpHeader<'_>) {
-        if h.service_type != service_type::REQUEST {
+        if h.service_type != service_type::REQUEST || self.dcp_deaf {
+            return;
+        }
+        if self.config.fault == Some(Fault::DcpDeafAfterMalformedIdentify)
+            && class == FrameClass::DcpIdentifyRequest
+            && h.iter_blocks().any(|b| b.is_err())
+        {
+            self.dcp_deaf = true;
             return;
         }
         match (class, h.service_id) {

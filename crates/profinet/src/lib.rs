@@ -38,5 +38,5 @@ pub mod udp;
 pub use controller::{
     Controller, ControllerConfig, ControllerError, ControllerEvent, InputData, RecordId,
 };
-pub use device::{ArEnd, Device, DeviceConfig, DeviceError, DeviceEvent};
+pub use device::{ArEnd, Device, DeviceConfig, DeviceError, DeviceEvent, Fault};
 pub use identity::{Identity, IdentityError};
