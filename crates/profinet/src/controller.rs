@@ -517,6 +517,11 @@ impl Controller {
                 });
                 self.input_deadline = now + self.period() * u32::from(self.config.data_hold_factor);
             }
+            Incoming::Arp(payload) => {
+                if let Some(f) = crate::arp::answer(payload, own, self.config.ip) {
+                    push(&mut self.tx, f);
+                }
+            }
             Incoming::Alarm { src, dst, alarm }
                 if dst == own
                     && self.device.is_some_and(|(m, _)| m == src)

@@ -426,6 +426,11 @@ impl Device {
             } if dst == own && ep.dst == self.ip && station::has_ip(self.ip) => {
                 self.cm(now, src, ep, &header, &message)
             }
+            Incoming::Arp(payload) => {
+                if let Some(f) = crate::arp::answer(payload, own, self.ip) {
+                    push(&mut self.tx, f);
+                }
+            }
             Incoming::OtherRpc {
                 src,
                 dst,

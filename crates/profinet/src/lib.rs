@@ -3,7 +3,7 @@
 //!
 //! - Encoders, one protocol layer each: [`eth`] (Ethernet II, 802.1Q), [`udp`] (IPv4/UDP),
 //!   [`rpc`] (DCE/RPC connectionless), [`cm`] (PNIO-CM blocks), [`dcp`] (DCP), [`rt`]
-//!   (cyclic and alarm frames). Decoding is `drivespec_capture`'s: every frame built here
+//!   (cyclic and alarm frames), [`arp`] (ARP replies). Decoding is `drivespec_capture`'s: every frame built here
 //!   reads back through its decoders.
 //! - [`status`]: the PNIOStatus values sent and recognised; [`identity`]: vendor and device
 //!   ID, slots, idents and I&M0 from the spec.
@@ -22,6 +22,7 @@
 //! module names (queues, caches); every wait of the controller has a deadline.
 #![forbid(unsafe_code)]
 
+pub mod arp;
 mod buf;
 pub mod cm;
 pub mod controller;

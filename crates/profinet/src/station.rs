@@ -62,6 +62,8 @@ pub(crate) enum Incoming<'a> {
         /// The RTA-PDU.
         alarm: AlarmHeader<'a>,
     },
+    /// An ARP packet (the payload after the Ethertype).
+    Arp(&'a [u8]),
     /// A DCE/RPC PDU for another interface (e.g. the endpoint mapper).
     OtherRpc {
         /// Sender MAC.
@@ -151,6 +153,7 @@ pub(crate) fn classify(frame: &[u8]) -> Option<Incoming<'_>> {
                 message,
             })
         }
+        drivespec_capture::arp::ETHERTYPE => Some(Incoming::Arp(link.payload)),
         _ => None,
     }
 }

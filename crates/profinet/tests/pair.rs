@@ -959,3 +959,36 @@ fn a_planted_dcp_fault_silences_the_device_after_a_malformed_identify() {
     assert!(!identify_all(&mut bad, 2, &malformed));
     assert!(!identify_all(&mut bad, 3, &all), "the planted fault");
 }
+
+#[test]
+fn both_stations_answer_arp_for_their_address() {
+    use drivespec_capture::arp::{parse_arp, Arp, REPLY, REQUEST};
+    let asker = [0x02, 0, 0, 0, 0, 9];
+    let ask = |ip| {
+        drivespec_profinet::arp::frame(
+            eth::BROADCAST,
+            &Arp {
+                operation: REQUEST,
+                sender_mac: asker,
+                sender_ip: [192, 168, 10, 9],
+                target_mac: [0; 6],
+                target_ip: ip,
+            },
+        )
+    };
+    let mut d = device();
+    d.handle_frame(Duration::ZERO, &ask(DEV_IP));
+    let res = d.poll_transmit(Duration::ZERO).unwrap();
+    assert_eq!(&res[..6], &asker);
+    let a = parse_arp(&res[14..]).unwrap();
+    assert_eq!(
+        (a.operation, a.sender_mac, a.sender_ip),
+        (REPLY, DEV_MAC, DEV_IP)
+    );
+    d.handle_frame(Duration::ZERO, &ask([192, 168, 10, 77]));
+    assert_eq!(d.poll_transmit(Duration::ZERO), None, "not its address");
+    let mut c = Controller::new(controller_config());
+    c.handle_frame(Duration::ZERO, &ask(CTL_IP));
+    let res = c.poll_transmit(Duration::ZERO).unwrap();
+    assert_eq!(parse_arp(&res[14..]).unwrap().sender_mac, CTL_MAC);
+}
