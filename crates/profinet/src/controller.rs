@@ -162,6 +162,9 @@ pub enum ControllerError {
     /// The request needs an AR in data exchange.
     #[error("no AR in data exchange")]
     NotRunning,
+    /// The device rejected a call at the RPC level (C706 reject or fault status).
+    #[error("RPC call rejected with status {0:#010x}")]
+    Rejected(u32),
     /// Too many requests wait already.
     #[error("{MAX_QUEUED} requests wait already")]
     Busy,
@@ -532,6 +535,37 @@ impl Controller {
                     _ => PnioStatus::default(),
                 };
                 self.fail(ControllerError::Aborted(s));
+            }
+            Incoming::OtherRpc {
+                src,
+                dst,
+                ep,
+                header,
+                body,
+            } if dst == own
+                && ep.dst == self.config.ip
+                && matches!(header.ptype, PacketType::REJECT | PacketType::FAULT) =>
+            {
+                let mine = self.device.is_some_and(|(d, _)| d == src)
+                    && header.activity == self.activity()
+                    && self.calls.front().is_some_and(|c| {
+                        c.sequence == header.sequence && c.kind != CallKind::SetIp
+                    });
+                if mine {
+                    let order = header.drep.integer;
+                    let st = match body {
+                        [a, b, c, d, ..] => match order {
+                            drivespec_capture::Endian::Big => u32::from_be_bytes([*a, *b, *c, *d]),
+                            drivespec_capture::Endian::Little => {
+                                u32::from_le_bytes([*a, *b, *c, *d])
+                            }
+                        },
+                        _ => 0,
+                    };
+                    if let Some(call) = self.calls.pop_front() {
+                        self.call_failed(call.kind, ControllerError::Rejected(st));
+                    }
+                }
             }
             Incoming::Cm {
                 src,

@@ -19,6 +19,8 @@
 //!   the modules of 3.2.1 is refused with the faulty field.
 //! - DCP Set of NameOfStation or IP while an AR runs is refused (BlockError "SET not
 //!   possible by local reasons").
+//! - Calls to other RPC interfaces are rejected (nca_unk_if); a ping repeats a kept answer
+//!   or gets nocall. ARP requests for the device's address are answered.
 
 use crate::cm::{self, Blocks};
 use crate::dcp::{self, block_error, opt, service, service_type, DcpBlocks};
@@ -436,19 +438,9 @@ impl Device {
                 dst,
                 ep,
                 header,
-            } if dst == own
-                && ep.dst == self.ip
-                && ep.dst_port == PNIO_PORT
-                && header.ptype == PacketType::REQUEST =>
-            {
-                // C706 12.5.3.9: a call to an interface this server does not offer is
-                // rejected with nca_unk_if.
-                let mut h = rpc::response_header(&header, self.config.server_boot);
-                h.ptype = PacketType::REJECT;
-                let body = NCA_UNK_IF.to_le_bytes();
-                self.ip_id = self.ip_id.wrapping_add(1);
-                let f = station::rpc_frame(own, src, station::reply(ep), self.ip_id, &h, &body);
-                push(&mut self.tx, f);
+                ..
+            } if dst == own && ep.dst == self.ip && station::has_ip(self.ip) => {
+                self.other_rpc(src, ep, &header)
             }
             _ => {}
         }
@@ -929,6 +921,34 @@ impl Device {
             }
             _ => {}
         }
+    }
+
+    /// PDUs that are no PNIO-CM call: a call to another interface is rejected with
+    /// nca_unk_if (C706 12.5.3.9); a ping of a call answered is answered again, of any other
+    /// call with nocall (C706 12.5.3.6, the device answers every call at once).
+    fn other_rpc(&mut self, src: Mac, ep: Endpoints, header: &drivespec_capture::dcerpc::Header) {
+        let own = self.config.mac;
+        let (ptype, body) = if !header.interface.is_pnio_interface() {
+            if header.ptype != PacketType::REQUEST || ep.dst_port != PNIO_PORT {
+                return;
+            }
+            (PacketType::REJECT, NCA_UNK_IF.to_le_bytes().to_vec())
+        } else if header.ptype == PacketType::PING {
+            let key = (header.activity, header.sequence);
+            if let Some((_, f)) = self.cache.iter().find(|(k, _)| *k == key) {
+                let f = f.clone();
+                push(&mut self.tx, f);
+                return;
+            }
+            (PacketType::NOCALL, Vec::new())
+        } else {
+            return;
+        };
+        let mut h = rpc::response_header(header, self.config.server_boot);
+        h.ptype = ptype;
+        self.ip_id = self.ip_id.wrapping_add(1);
+        let f = station::rpc_frame(own, src, station::reply(ep), self.ip_id, &h, &body);
+        push(&mut self.tx, f);
     }
 
     /// Answers one call: its PNIOStatus and response blocks.

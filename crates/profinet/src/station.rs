@@ -5,7 +5,7 @@
 use crate::eth::{self, Mac};
 use crate::rpc;
 use crate::udp::{self, Endpoints, Ipv4};
-use drivespec_capture::dcerpc::{self, Header};
+use drivespec_capture::dcerpc::{self, Header, PacketType};
 use drivespec_capture::ip::parse_ipv4_udp;
 use drivespec_capture::link::{ethertype, parse_ethernet};
 use drivespec_capture::pnio::{self, CmMessage};
@@ -64,7 +64,8 @@ pub(crate) enum Incoming<'a> {
     },
     /// An ARP packet (the payload after the Ethertype).
     Arp(&'a [u8]),
-    /// A DCE/RPC PDU for another interface (e.g. the endpoint mapper).
+    /// A DCE/RPC PDU that is no PNIO-CM call or answer: another interface (e.g. the endpoint
+    /// mapper), or a ping, working, nocall, fault or reject.
     OtherRpc {
         /// Sender MAC.
         src: Mac,
@@ -74,6 +75,8 @@ pub(crate) enum Incoming<'a> {
         ep: Endpoints,
         /// The RPC header.
         header: Header,
+        /// The body (a fault or reject carries its status).
+        body: &'a [u8],
     },
     /// A PNIO-CM call or answer (not fragmented).
     Cm {
@@ -126,7 +129,8 @@ pub(crate) fn classify(frame: &[u8]) -> Option<Incoming<'_>> {
             if h.is_fragment() {
                 return None;
             }
-            if !h.interface.is_pnio_interface() {
+            let call = matches!(h.ptype, PacketType::REQUEST | PacketType::RESPONSE);
+            if !h.interface.is_pnio_interface() || !call {
                 return Some(Incoming::OtherRpc {
                     src,
                     ep: Endpoints {
@@ -137,6 +141,7 @@ pub(crate) fn classify(frame: &[u8]) -> Option<Incoming<'_>> {
                     },
                     dst,
                     header: h,
+                    body: packet.body,
                 });
             }
             let message = pnio::decode_body(h.ptype, h.opnum, h.drep.integer, packet.body).ok()?;

@@ -992,3 +992,53 @@ fn both_stations_answer_arp_for_their_address() {
     let res = c.poll_transmit(Duration::ZERO).unwrap();
     assert_eq!(parse_arp(&res[14..]).unwrap().sender_mac, CTL_MAC);
 }
+
+#[test]
+fn a_ping_gets_the_answer_again_or_nocall() {
+    use drivespec_capture::dcerpc::{self, PacketType, Uuid};
+    use drivespec_profinet::{rpc, udp};
+    let mut p = Pair::running(controller_config());
+    // The Connect call: its activity and sequence from the recording.
+    let (_, connect) = p
+        .frames
+        .iter()
+        .find(|(_, f)| f.get(..6) == Some(&DEV_MAC[..]) && f.get(12..14) == Some(&[0x08, 0x00][..]))
+        .unwrap()
+        .clone();
+    let l = drivespec_capture::link::parse_ethernet(&connect).unwrap();
+    let u = drivespec_capture::ip::parse_ipv4_udp(l.payload).unwrap();
+    let call = dcerpc::parse(u.payload).unwrap().header;
+    let ping = |seq: u32| {
+        let mut h = rpc::request_header(call.object, Uuid::PNIO_DEVICE, call.activity, seq, 0);
+        h.ptype = PacketType::PING;
+        let ep = udp::Endpoints {
+            src: CTL_IP,
+            src_port: 0xC001,
+            dst: DEV_IP,
+            dst_port: PNIO_PORT,
+        };
+        eth::frame(
+            DEV_MAC,
+            CTL_MAC,
+            None,
+            ethertype::IPV4,
+            &udp::ipv4_udp(ep, 1, &rpc::encode(&h, &[])),
+        )
+    };
+    let answer = |d: &mut Device, f: &[u8]| {
+        d.handle_frame(p.now, f);
+        let res = d.poll_transmit(p.now).unwrap();
+        let l = drivespec_capture::link::parse_ethernet(&res).unwrap();
+        let u = drivespec_capture::ip::parse_ipv4_udp(l.payload).unwrap();
+        dcerpc::parse(u.payload).unwrap().header
+    };
+    let mut d = p.dev.clone();
+    let again = answer(&mut d, &ping(call.sequence));
+    assert_eq!(
+        (again.ptype, again.sequence, again.opnum),
+        (PacketType::RESPONSE, call.sequence, 0)
+    );
+    let unknown = answer(&mut d, &ping(call.sequence + 1000));
+    assert_eq!(unknown.ptype, PacketType::NOCALL);
+    p.run_for(Duration::from_millis(1));
+}
