@@ -54,6 +54,8 @@ pub const MAX_CACHED: usize = 16;
 
 /// The reject status of an unknown interface (C706 appendix E: nca_unk_if).
 pub const NCA_UNK_IF: u32 = 0x1C01_0003;
+/// The reject status of an operation number out of range (C706 appendix E: nca_op_rng_error).
+pub const NCA_OP_RNG_ERROR: u32 = 0x1C01_0002;
 
 /// Most option pairs of one DCP Get answered (the answer stays within one frame).
 pub const MAX_GET: usize = 32;
@@ -865,7 +867,11 @@ impl Device {
                     push(&mut self.tx, f);
                     return;
                 }
-                let (status, blocks) = self.call(now, src, ep, m);
+                let Some((status, blocks)) = self.call(now, src, ep, m) else {
+                    // C706 12.5.3.9: an operation the interface does not have.
+                    self.reject(src, ep, h, NCA_OP_RNG_ERROR);
+                    return;
+                };
                 if !status.is_ok() {
                     push(
                         &mut self.events,
@@ -927,54 +933,73 @@ impl Device {
     /// nca_unk_if (C706 12.5.3.9); a ping of a call answered is answered again, of any other
     /// call with nocall (C706 12.5.3.6, the device answers every call at once).
     fn other_rpc(&mut self, src: Mac, ep: Endpoints, header: &drivespec_capture::dcerpc::Header) {
-        let own = self.config.mac;
-        let (ptype, body) = if !header.interface.is_pnio_interface() {
-            if header.ptype != PacketType::REQUEST || ep.dst_port != PNIO_PORT {
-                return;
+        if !header.interface.is_pnio_interface() {
+            if header.ptype == PacketType::REQUEST && ep.dst_port == PNIO_PORT {
+                self.reject(src, ep, header, NCA_UNK_IF);
             }
-            (PacketType::REJECT, NCA_UNK_IF.to_le_bytes().to_vec())
-        } else if header.ptype == PacketType::PING {
+            return;
+        }
+        if header.ptype == PacketType::PING {
             let key = (header.activity, header.sequence);
             if let Some((_, f)) = self.cache.iter().find(|(k, _)| *k == key) {
                 let f = f.clone();
                 push(&mut self.tx, f);
                 return;
             }
-            (PacketType::NOCALL, Vec::new())
-        } else {
-            return;
-        };
+            self.rpc_pdu(src, ep, header, PacketType::NOCALL, &[]);
+        }
+    }
+
+    /// Rejects a call with `status` (C706 12.5.3.9: a reject PDU carries the status).
+    fn reject(
+        &mut self,
+        src: Mac,
+        ep: Endpoints,
+        header: &drivespec_capture::dcerpc::Header,
+        status: u32,
+    ) {
+        self.rpc_pdu(src, ep, header, PacketType::REJECT, &status.to_le_bytes());
+    }
+
+    /// Sends a PDU of `ptype` for the call `header`, from the endpoint it came to.
+    fn rpc_pdu(
+        &mut self,
+        src: Mac,
+        ep: Endpoints,
+        header: &drivespec_capture::dcerpc::Header,
+        ptype: PacketType,
+        body: &[u8],
+    ) {
         let mut h = rpc::response_header(header, self.config.server_boot);
         h.ptype = ptype;
         self.ip_id = self.ip_id.wrapping_add(1);
-        let f = station::rpc_frame(own, src, station::reply(ep), self.ip_id, &h, &body);
+        let f = station::rpc_frame(
+            self.config.mac,
+            src,
+            station::reply(ep),
+            self.ip_id,
+            &h,
+            body,
+        );
         push(&mut self.tx, f);
     }
 
-    /// Answers one call: its PNIOStatus and response blocks.
+    /// Answers one call: its PNIOStatus and response blocks; `None` for an unknown operation.
     fn call(
         &mut self,
         now: Duration,
         src: Mac,
         ep: Endpoints,
         m: &CmMessage,
-    ) -> (PnioStatus, Vec<u8>) {
-        match m.operation {
+    ) -> Option<(PnioStatus, Vec<u8>)> {
+        Some(match m.operation {
             Operation::Connect => self.connect(now, src, ep, m),
             Operation::Read | Operation::ReadImplicit => self.read(m),
             Operation::Write => self.write(m),
             Operation::Control => self.control(m, false),
             Operation::Release => self.control(m, true),
-            Operation::Other(_) => (
-                status::status(
-                    status::CONNECT,
-                    status::PNIO,
-                    code1::CMRPC,
-                    code2::UNKNOWN_BLOCKS,
-                ),
-                Vec::new(),
-            ),
-        }
+            Operation::Other(_) => return None,
+        })
     }
 
     fn connect(

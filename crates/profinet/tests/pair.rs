@@ -1042,3 +1042,29 @@ fn a_ping_gets_the_answer_again_or_nocall() {
     assert_eq!(unknown.ptype, PacketType::NOCALL);
     p.run_for(Duration::from_millis(1));
 }
+
+#[test]
+fn an_unknown_operation_is_rejected() {
+    use drivespec_capture::dcerpc::{self, PacketType, Uuid};
+    use drivespec_profinet::{cm, rpc, udp};
+    let mut d = device();
+    let h = rpc::request_header(Uuid::default(), Uuid::PNIO_DEVICE, Uuid([7; 16]), 0, 9);
+    let body = cm::request(4096, &[], drivespec_capture::Endian::Little);
+    let ep = udp::Endpoints {
+        src: CTL_IP,
+        src_port: 0xC001,
+        dst: DEV_IP,
+        dst_port: PNIO_PORT,
+    };
+    let ip = udp::ipv4_udp(ep, 1, &rpc::encode(&h, &body));
+    d.handle_frame(
+        Duration::ZERO,
+        &eth::frame(DEV_MAC, CTL_MAC, None, ethertype::IPV4, &ip),
+    );
+    let res = d.poll_transmit(Duration::ZERO).unwrap();
+    let l = drivespec_capture::link::parse_ethernet(&res).unwrap();
+    let u = drivespec_capture::ip::parse_ipv4_udp(l.payload).unwrap();
+    let p = dcerpc::parse(u.payload).unwrap();
+    assert_eq!(p.header.ptype, PacketType::REJECT);
+    assert_eq!(p.body, &0x1C01_0002u32.to_le_bytes()[..]);
+}
