@@ -295,6 +295,7 @@ pub struct Controller {
     in_frames: u64,
     input_deadline: Duration,
     output_frame: FrameId,
+    input_frame: FrameId,
     layout: Layout,
     now: Duration,
 }
@@ -336,6 +337,7 @@ impl Controller {
             in_frames: 0,
             input_deadline: Duration::MAX,
             output_frame: FrameId(0xFFFF),
+            input_frame: INPUT_FRAME_ID,
             now: Duration::ZERO,
         }
     }
@@ -497,7 +499,7 @@ impl Controller {
             } if dst == own => self.dcp(src, class, &dcp),
             Incoming::Cyclic { src, dst, frame } if dst == own => {
                 let Some((dev, _)) = self.device else { return };
-                if src != dev || frame.frame_id != INPUT_FRAME_ID {
+                if src != dev || frame.frame_id != self.input_frame {
                     return;
                 }
                 let ds = frame.apdu.data_status;
@@ -1102,8 +1104,17 @@ impl Controller {
                     })
                     .filter_map(Result::ok)
                     .flat_map(|d| d.modules)
+                    .filter(wrong)
                     .collect();
                 self.output_frame = out_frame;
+                self.input_frame = m
+                    .blocks
+                    .iter()
+                    .find_map(|b| match b {
+                        Block::IocrRes(r) if r.iocr_type == 1 => Some(r.frame_id),
+                        _ => None,
+                    })
+                    .unwrap_or(INPUT_FRAME_ID);
                 self.alarm_remote = m
                     .blocks
                     .iter()
@@ -1264,6 +1275,18 @@ impl Controller {
         );
         eth::frame(dev, self.config.mac, None, ethertype::PROFINET, &pdu)
     }
+}
+
+/// Whether a ModuleDiffBlock entry means the device is not the expected PSD4xx: no module or
+/// a wrong module (ModuleState 0, 1), or a submodule whose IdentInfo (SubmoduleState format
+/// 1, bits 11–14) is Wrong (2) or NoSubmodule (3). Substitutes and entries that only report
+/// ARInfo or diagnosis (e.g. ApplicationReadyPending) are accepted (IEC 61158-6-10
+/// "ModuleDiffBlock").
+fn wrong(m: &DiffModule) -> bool {
+    let bad_sub = |s: &drivespec_capture::pnio::DiffSubmodule| {
+        s.state & 0x8000 != 0 && matches!((s.state >> 11) & 0x0F, 2 | 3)
+    };
+    matches!(m.state, 0 | 1) || m.submodules.iter().any(bad_sub)
 }
 
 fn header(block_type: u16) -> BlockHeader {

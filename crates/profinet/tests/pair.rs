@@ -66,6 +66,8 @@ struct Pair {
     dev_events: Vec<DeviceEvent>,
     /// Device frames that are lost on the wire.
     lost: fn(&[u8]) -> bool,
+    /// Device frames as the controller gets them.
+    rewrite: fn(Vec<u8>) -> Vec<u8>,
 }
 
 impl Pair {
@@ -78,6 +80,7 @@ impl Pair {
             ctl_events: Vec::new(),
             dev_events: Vec::new(),
             lost: |_| false,
+            rewrite: |f| f,
         };
         p.ctl.start(p.now);
         p
@@ -95,6 +98,7 @@ impl Pair {
                 if (self.lost)(&f) {
                     continue;
                 }
+                let f = (self.rewrite)(f);
                 self.ctl.handle_frame(self.now, &f);
                 self.frames.push((self.now, f));
                 moved = true;
@@ -1067,4 +1071,104 @@ fn an_unknown_operation_is_rejected() {
     let p = dcerpc::parse(u.payload).unwrap();
     assert_eq!(p.header.ptype, PacketType::REJECT);
     assert_eq!(p.body, &0x1C01_0002u32.to_le_bytes()[..]);
+}
+
+/// The device's Connect response with a ModuleDiffBlock appended that lists `diff`.
+fn with_diff(frame: Vec<u8>, diff: drivespec_capture::pnio::ModuleDiff) -> Vec<u8> {
+    use drivespec_capture::dcerpc::{self, PacketType};
+    use drivespec_capture::pnio::{self, Operation};
+    use drivespec_profinet::{cm, rpc, udp};
+    let Ok(l) = drivespec_capture::link::parse_ethernet(&frame) else {
+        return frame;
+    };
+    let Ok(u) = drivespec_capture::ip::parse_ipv4_udp(l.payload) else {
+        return frame;
+    };
+    let Ok(p) = dcerpc::parse(u.payload) else {
+        return frame;
+    };
+    let h = p.header;
+    let Ok(m) = pnio::decode_body(h.ptype, h.opnum, h.drep.integer, p.body) else {
+        return frame;
+    };
+    if h.ptype != PacketType::RESPONSE || m.operation != Operation::Connect {
+        return frame;
+    }
+    let mut blocks = p.body[20..].to_vec();
+    let mut extra = cm::Blocks::new();
+    extra.module_diff(&diff);
+    blocks.extend_from_slice(&extra.into_bytes());
+    let body = cm::response(PnioStatus::default(), &blocks, h.drep.integer);
+    let ep = udp::Endpoints {
+        src: u.src,
+        src_port: u.src_port,
+        dst: u.dst,
+        dst_port: u.dst_port,
+    };
+    eth::frame(
+        l.dst.unwrap(),
+        l.src.unwrap(),
+        None,
+        ethertype::IPV4,
+        &udp::ipv4_udp(ep, 1, &rpc::encode(&h, &body)),
+    )
+}
+
+#[test]
+fn a_module_diff_that_only_reports_state_is_accepted() {
+    use drivespec_capture::pnio::{DiffModule, DiffSubmodule, ModuleDiff};
+    let mut p = Pair::new(controller_config());
+    // Proper module, submodule with ARInfo ApplicationReadyPending (format 1, bits 7-10 = 1).
+    p.rewrite = |f| {
+        with_diff(
+            f,
+            ModuleDiff {
+                modules: vec![DiffModule {
+                    api: 0,
+                    slot: 1,
+                    ident: 0x101,
+                    state: 2,
+                    submodules: vec![DiffSubmodule {
+                        subslot: 1,
+                        ident: 1,
+                        state: 0x8000 | (1 << 7),
+                    }],
+                }],
+            },
+        )
+    };
+    assert!(
+        p.run_until(Duration::from_secs(5), |p| p.ctl.is_running()),
+        "{:?}",
+        p.ctl_events
+    );
+    // A wrong submodule (IdentInfo Wrong) is not.
+    let mut p = Pair::new(controller_config());
+    p.rewrite = |f| {
+        with_diff(
+            f,
+            ModuleDiff {
+                modules: vec![DiffModule {
+                    api: 0,
+                    slot: 2,
+                    ident: 0x102,
+                    state: 2,
+                    submodules: vec![DiffSubmodule {
+                        subslot: 1,
+                        ident: 5,
+                        state: 0x8000 | (2 << 11),
+                    }],
+                }],
+            },
+        )
+    };
+    p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+    assert!(
+        matches!(
+            p.ctl_events.last(),
+            Some(ControllerEvent::Failed(ControllerError::ModuleDiff(_)))
+        ),
+        "{:?}",
+        p.ctl_events
+    );
 }
