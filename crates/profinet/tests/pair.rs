@@ -1172,3 +1172,173 @@ fn a_module_diff_that_only_reports_state_is_accepted() {
         p.ctl_events
     );
 }
+
+/// Runs `tshark` on `pcap` with a display filter; `None` when tshark is not installed.
+fn tshark_lines(pcap: &[u8], filter: &str) -> Option<Vec<String>> {
+    use std::process::Command;
+    if Command::new("tshark").arg("--version").output().is_err() {
+        return None;
+    }
+    let path = std::env::temp_dir().join(format!(
+        "drivespec-profinet-{}-{filter:.8}.pcap",
+        std::process::id()
+    ));
+    std::fs::write(&path, pcap).unwrap();
+    let out = Command::new("tshark")
+        .arg("-n")
+        .arg("-r")
+        .arg(&path)
+        .arg("-Y")
+        .arg(filter)
+        .output()
+        .unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .map(str::to_owned)
+            .collect(),
+    )
+}
+
+/// Wireshark, an independent decoder, reads every frame both stations send (start-up,
+/// cyclic data, records, refusals, ModuleDiff, DCP, ARP, aborts) without a malformed frame
+/// or an expert note, warning or error. Runs where `tshark` is installed, says "skipped" otherwise.
+#[test]
+fn tshark_decodes_every_frame_without_malformed_or_expert_info() {
+    let id = Identity::from_spec(spec()).unwrap();
+    let mut frames = Vec::new();
+    // A whole session with records, a refusal and a watchdog abort.
+    let mut p = Pair::running(controller_config());
+    p.ctl.set_output(&output(
+        Request::Read {
+            pnu: 13,
+            index: None,
+        },
+        0x54,
+        400,
+    ));
+    p.run_for(Duration::from_millis(30));
+    for index in [1, 13, 0x7FFF] {
+        let rid = p
+            .ctl
+            .read_record(p.now, id.output.slot, id.output.subslot, index)
+            .unwrap();
+        let _ = p.record(rid);
+    }
+    let rid = p.ctl.read_record(p.now, id.dap_slot, 1, 0xAFF0).unwrap();
+    p.record(rid).unwrap();
+    let data = RecordWrite {
+        index: 44,
+        control: 1,
+        width: Width::Word,
+        value: 7,
+    }
+    .to_bytes(rules().record())
+    .unwrap();
+    let rid = p
+        .ctl
+        .write_record(p.now, id.output.slot, id.output.subslot, 44, &data)
+        .unwrap();
+    p.record(rid).unwrap();
+    p.ctl.set_sending(false);
+    p.run_until(p.now + Duration::from_secs(1), |p| p.ctl.is_closed());
+    frames.extend(p.frames);
+    // A ModuleDiff and its Release; a refused Connect.
+    let mut c = controller_config();
+    c.identity.output.module_ident = 0x999;
+    let mut p = Pair::new(c);
+    p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+    p.run_for(Duration::from_millis(5));
+    frames.extend(p.frames);
+    let mut c = controller_config();
+    c.send_clock_factor = 9;
+    let mut p = Pair::new(c);
+    p.run_until(Duration::from_secs(5), |p| p.ctl.is_closed());
+    frames.extend(p.frames);
+    // DCP Hello, Set, Get and an ARP answer.
+    let mut dc = DeviceConfig::new(spec(), "PSD426", DEV_MAC, NAME).unwrap();
+    dc.hello = true;
+    dc.ip = DEV_IP;
+    let mut d = Device::new(spec(), dc).unwrap();
+    let mut set = DcpBlocks::new();
+    set.with_info(opt::NAME_OF_STATION, dcp::PERMANENT, b"psd-07");
+    let requests = [
+        eth::frame(
+            DEV_MAC,
+            CTL_MAC,
+            None,
+            ethertype::PROFINET,
+            &dcp::pdu(
+                FrameId::DCP_GET_SET,
+                service::SET,
+                service_type::REQUEST,
+                9,
+                0,
+                &set.into_bytes(),
+            ),
+        ),
+        eth::frame(
+            DEV_MAC,
+            CTL_MAC,
+            None,
+            ethertype::PROFINET,
+            &dcp::pdu(
+                FrameId::DCP_GET_SET,
+                service::GET,
+                service_type::REQUEST,
+                10,
+                0,
+                &[2, 2, 2, 3, 1, 2, 2, 9],
+            ),
+        ),
+        drivespec_profinet::arp::frame(
+            eth::BROADCAST,
+            &drivespec_capture::arp::Arp {
+                operation: drivespec_capture::arp::REQUEST,
+                sender_mac: CTL_MAC,
+                sender_ip: CTL_IP,
+                target_mac: [0; 6],
+                target_ip: DEV_IP,
+            },
+        ),
+    ];
+    while let Some(f) = d.poll_transmit(Duration::ZERO) {
+        frames.push((Duration::ZERO, f));
+    }
+    for r in requests {
+        d.handle_frame(Duration::ZERO, &r);
+        frames.push((Duration::ZERO, r));
+        while let Some(f) = d.poll_transmit(Duration::ZERO) {
+            frames.push((Duration::ZERO, f));
+        }
+    }
+    let mut w = PcapWriter::new(Vec::new(), LinkType::ETHERNET, 65535).unwrap();
+    for (i, (_, f)) in frames.iter().enumerate() {
+        w.write_packet(T0_US + i as u64, f).unwrap();
+    }
+    let pcap = w.into_inner().unwrap();
+    // Expert notes of severity "chat" (e.g. the BlockError of a refused DCP Get) describe
+    // the exchange; notes, warnings and errors would mean a frame Wireshark finds wrong.
+    let Some(bad) = tshark_lines(&pcap, "_ws.malformed || _ws.expert.severity >= 0x00400000")
+    else {
+        eprintln!("skipped: tshark is not installed");
+        return;
+    };
+    assert!(bad.is_empty(), "{bad:#?}");
+    let all = tshark_lines(&pcap, "frame").unwrap();
+    assert_eq!(all.len(), frames.len());
+    let known = tshark_lines(&pcap, "pn_dcp || pn_rt || dcerpc || arp").unwrap();
+    assert_eq!(
+        known.len(),
+        frames.len(),
+        "every frame is PROFINET, DCE/RPC or ARP to Wireshark"
+    );
+    let cm = tshark_lines(&pcap, "pn_io").unwrap();
+    assert!(cm.len() >= 20, "{cm:#?}");
+}
