@@ -198,10 +198,109 @@ pub enum ControllerEvent {
         /// The data read (empty for a write), or why it failed.
         result: Result<Vec<u8>, ControllerError>,
     },
+    /// The device sent an alarm notification; it was acknowledged.
+    Alarm(AlarmNote),
     /// The AR was released.
     Released,
     /// The controller stopped.
     Failed(ControllerError),
+}
+
+/// An alarm notification (IEC 61158-6-10 "AlarmNotification-PDU": BlockType 0x0001 low or
+/// 0x0002 high, AlarmType, API, slot, subslot, idents, AlarmSpecifier, then items).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AlarmNote {
+    /// BlockType (0x0001 low, 0x0002 high).
+    pub block_type: u16,
+    /// AlarmType (1 diagnosis, 2 process, …).
+    pub alarm_type: u16,
+    /// API.
+    pub api: u32,
+    /// SlotNumber.
+    pub slot: u16,
+    /// SubslotNumber.
+    pub subslot: u16,
+    /// ModuleIdentNumber.
+    pub module_ident: u32,
+    /// SubmoduleIdentNumber.
+    pub submodule_ident: u32,
+    /// AlarmSpecifier (sequence number, channel/manufacturer diagnosis, …).
+    pub specifier: u16,
+    /// The alarm items after the specifier.
+    pub items: Vec<u8>,
+}
+
+impl AlarmNote {
+    /// Reads a notification block from an RTA var part; `None` if it is none.
+    fn parse(var: &[u8]) -> Option<AlarmNote> {
+        let be16 = |at: usize| {
+            var.get(at..at + 2)
+                .and_then(|b| <[u8; 2]>::try_from(b).ok())
+                .map(u16::from_be_bytes)
+        };
+        let be32 = |at: usize| {
+            var.get(at..at + 4)
+                .and_then(|b| <[u8; 4]>::try_from(b).ok())
+                .map(u32::from_be_bytes)
+        };
+        let block_type = be16(0)?;
+        if !matches!(block_type, 0x0001 | 0x0002) {
+            return None;
+        }
+        let end = 4 + usize::from(be16(2)?);
+        Some(AlarmNote {
+            block_type,
+            alarm_type: be16(6)?,
+            api: be32(8)?,
+            slot: be16(12)?,
+            subslot: be16(14)?,
+            module_ident: be32(16)?,
+            submodule_ident: be32(20)?,
+            specifier: be16(24)?,
+            items: var.get(26..end.max(26))?.to_vec(),
+        })
+    }
+}
+
+/// Sequence numbers of the alarm channel (IEC 61158-6-10 APMS/APMR: start 0xFFFF, then
+/// 0…0x7FFF cyclically).
+#[derive(Debug, Clone, Copy)]
+struct RtaSeq {
+    /// SendSeqNum of the next DATA.
+    send: u16,
+    /// SendSeqNum of the last DATA the device acknowledged.
+    sent: u16,
+    /// SendSeqNum expected of the device's next DATA.
+    expected: u16,
+    /// SendSeqNum of the device's last DATA.
+    received: u16,
+}
+
+impl Default for RtaSeq {
+    fn default() -> RtaSeq {
+        RtaSeq {
+            send: 0xFFFF,
+            sent: 0xFFFE,
+            expected: 0xFFFF,
+            received: 0xFFFE,
+        }
+    }
+}
+
+fn next_seq(s: u16) -> u16 {
+    if s == 0xFFFF {
+        0
+    } else {
+        s.wrapping_add(1) & 0x7FFF
+    }
+}
+
+/// The FrameID of a received frame (after any VLAN tags).
+fn frame_id_of(frame: &[u8]) -> FrameId {
+    drivespec_capture::link::parse_ethernet(frame)
+        .ok()
+        .and_then(|l| drivespec_capture::rt::RtFrame::parse(l.payload).ok())
+        .map_or(FrameId::ALARM_LOW, |r| r.frame_id)
 }
 
 /// The latest input frame's contents (our doc: module `controller`).
@@ -286,6 +385,7 @@ pub struct Controller {
     next_record: u64,
     record_seq: u16,
     alarm_remote: Option<u16>,
+    rta: RtaSeq,
     ip_id: u16,
     cyclic: bool,
     sending: bool,
@@ -329,6 +429,7 @@ impl Controller {
             next_record: 0,
             record_seq: 0,
             alarm_remote: None,
+            rta: RtaSeq::default(),
             ip_id: 0,
             cyclic: false,
             sending: true,
@@ -528,15 +629,9 @@ impl Controller {
                 }
             }
             Incoming::Alarm { src, dst, alarm }
-                if dst == own
-                    && self.device.is_some_and(|(m, _)| m == src)
-                    && alarm.pdu_type & 0x0f == 4 =>
+                if dst == own && self.device.is_some_and(|(m, _)| m == src) =>
             {
-                let s = match alarm.var_part {
-                    [a, b, c, d, ..] => status::status(*a, *b, *c, *d),
-                    _ => PnioStatus::default(),
-                };
-                self.fail(ControllerError::Aborted(s));
+                self.alarm(frame_id_of(frame), &alarm)
             }
             Incoming::OtherRpc {
                 src,
@@ -1256,6 +1351,84 @@ impl Controller {
             self.input_deadline =
                 self.now + self.period() * u32::from(self.config.data_hold_factor);
             push(&mut self.events, ControllerEvent::Running);
+        }
+    }
+
+    /// An RTA-PDU from the device (IEC 61158-6-10 APMR/ALPMR): ERR ends the AR; DATA (an
+    /// alarm notification) is acknowledged at once by an ACK-RTA-PDU and answered with an
+    /// AlarmAck in a DATA-RTA-PDU; a repeated DATA gets the ACK again. The AlarmAck is sent
+    /// once (a lost one is not repeated; the device repeats its notification).
+    fn alarm(&mut self, frame_id: FrameId, a: &drivespec_capture::rt::AlarmHeader<'_>) {
+        let Some((dev, _)) = self.device else { return };
+        match a.pdu_type & 0x0f {
+            4 => {
+                let s = match a.var_part {
+                    [a, b, c, d, ..] => status::status(*a, *b, *c, *d),
+                    _ => PnioStatus::default(),
+                };
+                self.fail(ControllerError::Aborted(s));
+            }
+            1 => {
+                let Some(remote) = self.alarm_remote.filter(|_| self.cyclic) else {
+                    return;
+                };
+                let fresh = a.send_seq == self.rta.expected;
+                if !fresh && a.send_seq != self.rta.received {
+                    return;
+                }
+                if fresh {
+                    self.rta.received = a.send_seq;
+                    self.rta.expected = next_seq(a.send_seq);
+                }
+                let ack = rt::alarm(
+                    frame_id,
+                    remote,
+                    ALARM_REF,
+                    rt::pdu_type::ACK,
+                    self.rta.sent,
+                    self.rta.received,
+                    &[],
+                );
+                let mac = self.config.mac;
+                push(
+                    &mut self.tx,
+                    eth::frame(dev, mac, None, ethertype::PROFINET, &ack),
+                );
+                if !fresh {
+                    return;
+                }
+                let Some(n) = AlarmNote::parse(a.var_part) else {
+                    return;
+                };
+                let mut body = Vec::with_capacity(16);
+                body.extend_from_slice(&n.alarm_type.to_be_bytes());
+                body.extend_from_slice(&n.api.to_be_bytes());
+                body.extend_from_slice(&n.slot.to_be_bytes());
+                body.extend_from_slice(&n.subslot.to_be_bytes());
+                body.extend_from_slice(&n.specifier.to_be_bytes());
+                body.extend_from_slice(&cm::status_u32(PnioStatus::default()).to_be_bytes());
+                let mut b = Blocks::new();
+                b.other(n.block_type | 0x8000, &body);
+                let data = rt::alarm(
+                    frame_id,
+                    remote,
+                    ALARM_REF,
+                    rt::pdu_type::DATA,
+                    self.rta.send,
+                    self.rta.received,
+                    &b.into_bytes(),
+                );
+                push(
+                    &mut self.tx,
+                    eth::frame(dev, mac, None, ethertype::PROFINET, &data),
+                );
+                push(&mut self.events, ControllerEvent::Alarm(n));
+            }
+            3 if a.ack_seq == self.rta.send => {
+                self.rta.sent = self.rta.send;
+                self.rta.send = next_seq(self.rta.send);
+            }
+            _ => {}
         }
     }
 

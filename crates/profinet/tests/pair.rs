@@ -1342,3 +1342,107 @@ fn tshark_decodes_every_frame_without_malformed_or_expert_info() {
     let cm = tshark_lines(&pcap, "pn_io").unwrap();
     assert!(cm.len() >= 20, "{cm:#?}");
 }
+
+#[test]
+fn alarm_notifications_are_acknowledged() {
+    use drivespec_capture::rt::RtFrame;
+    use drivespec_profinet::rt;
+    let mut p = Pair::running(controller_config());
+    let note = |seq: u16| {
+        // AlarmNotification low: diagnosis (1), API 0, slot 1/1, idents, specifier 0x0801.
+        let mut body = vec![0x00, 0x01, 0, 0, 0, 0, 0, 1, 0, 1];
+        body.extend_from_slice(&0x101u32.to_be_bytes());
+        body.extend_from_slice(&1u32.to_be_bytes());
+        body.extend_from_slice(&[0x08, 0x01, 0xAA]);
+        let mut b = drivespec_profinet::cm::Blocks::new();
+        b.other(0x0001, &body);
+        let pdu = rt::alarm(
+            FrameId::ALARM_LOW,
+            3,
+            1,
+            rt::pdu_type::DATA,
+            seq,
+            0xFFFE,
+            &b.into_bytes(),
+        );
+        eth::frame(CTL_MAC, DEV_MAC, None, ethertype::PROFINET, &pdu)
+    };
+    let alarms = |p: &mut Pair| -> Vec<(u8, u16, u16, Vec<u8>)> {
+        std::iter::from_fn(|| p.ctl.poll_transmit(p.now))
+            .filter_map(|f| {
+                let l = drivespec_capture::link::parse_ethernet(&f).ok()?;
+                let a = RtFrame::parse(l.payload).ok()?.alarm().ok()?;
+                Some((a.pdu_type, a.send_seq, a.ack_seq, a.var_part.to_vec()))
+            })
+            .collect()
+    };
+    p.ctl.handle_frame(p.now, &note(0xFFFF));
+    let sent = alarms(&mut p);
+    assert_eq!(sent.len(), 2, "{sent:?}");
+    assert_eq!(
+        (sent[0].0, sent[0].1, sent[0].2),
+        (rt::pdu_type::ACK, 0xFFFE, 0xFFFF)
+    );
+    let (t, s, a, ack) = &sent[1];
+    assert_eq!((*t, *s, *a), (rt::pdu_type::DATA, 0xFFFF, 0xFFFF));
+    // AlarmAck low (0x8001): AlarmType, API, slot, subslot, specifier, PNIOStatus OK.
+    assert_eq!(&ack[..2], &[0x80, 0x01]);
+    assert_eq!(
+        &ack[6..],
+        &[0, 1, 0, 0, 0, 0, 0, 1, 0, 1, 0x08, 0x01, 0, 0, 0, 0]
+    );
+    let n = p
+        .ctl_events
+        .iter()
+        .chain(
+            std::iter::from_fn(|| p.ctl.poll_event())
+                .collect::<Vec<_>>()
+                .iter(),
+        )
+        .find_map(|e| match e {
+            ControllerEvent::Alarm(n) => Some(n.clone()),
+            _ => None,
+        });
+    let n = n.expect("an alarm event");
+    assert_eq!(
+        (
+            n.alarm_type,
+            n.slot,
+            n.subslot,
+            n.specifier,
+            n.items.as_slice()
+        ),
+        (1, 1, 1, 0x0801, &[0xAA][..])
+    );
+    // The same notification again: only the ACK is repeated.
+    p.ctl.handle_frame(p.now, &note(0xFFFF));
+    let again = alarms(&mut p);
+    assert_eq!(again.len(), 1);
+    assert_eq!(again[0].0, rt::pdu_type::ACK);
+    // The device acknowledges the AlarmAck; the next notification (SendSeqNum 0) is new.
+    let ack = rt::alarm(
+        FrameId::ALARM_LOW,
+        3,
+        1,
+        rt::pdu_type::ACK,
+        0xFFFE,
+        0xFFFF,
+        &[],
+    );
+    p.ctl.handle_frame(
+        p.now,
+        &eth::frame(CTL_MAC, DEV_MAC, None, ethertype::PROFINET, &ack),
+    );
+    p.ctl.handle_frame(p.now, &note(0));
+    let next = alarms(&mut p);
+    assert_eq!(next.len(), 2);
+    assert_eq!(
+        (next[0].0, next[0].1, next[0].2),
+        (rt::pdu_type::ACK, 0xFFFF, 0)
+    );
+    assert_eq!(
+        (next[1].0, next[1].1, next[1].2),
+        (rt::pdu_type::DATA, 0, 0)
+    );
+    assert!(p.ctl.is_running());
+}
