@@ -1446,3 +1446,42 @@ fn alarm_notifications_are_acknowledged() {
     );
     assert!(p.ctl.is_running());
 }
+
+#[test]
+fn cyclic_frames_follow_send_clock_times_reduction_ratio() {
+    use drivespec_capture::rt::RtFrame;
+    for (scf, rr) in [(8u16, 1u16), (16, 4), (32, 2), (128, 1)] {
+        let mut c = controller_config();
+        c.send_clock_factor = scf;
+        c.reduction_ratio = rr;
+        let mut p = Pair::running(c);
+        let start = p.frames.len();
+        p.run_for(Duration::from_millis(100));
+        let period = u64::from(scf) * u64::from(rr) * 31_250;
+        for from_device in [true, false] {
+            let src = if from_device { DEV_MAC } else { CTL_MAC };
+            let frames: Vec<(u64, u16)> = p.frames[start..]
+                .iter()
+                .filter(|(_, f)| f.get(6..12) == Some(&src[..]))
+                .filter_map(|(t, f)| {
+                    let l = drivespec_capture::link::parse_ethernet(f).ok()?;
+                    let c = RtFrame::parse(l.payload).ok()?.cyclic().ok()?;
+                    Some((t.as_nanos() as u64, c.apdu.cycle_counter))
+                })
+                .collect();
+            assert!(
+                frames.len() as u64 >= 100_000_000 / period - 1,
+                "SCF {scf} RR {rr}: {} frames",
+                frames.len()
+            );
+            for w in frames.windows(2) {
+                assert_eq!(w[1].0 - w[0].0, period, "SCF {scf} RR {rr}: interval");
+                assert_eq!(
+                    w[1].1.wrapping_sub(w[0].1),
+                    scf * rr,
+                    "SCF {scf} RR {rr}: cycle counter"
+                );
+            }
+        }
+    }
+}
