@@ -499,6 +499,9 @@ impl Device {
         let Some(ar) = self.ar.take() else {
             return;
         };
+        // Answers kept for repeated calls belong to the AR: a controller that connects again
+        // with the same activity gets its calls executed, not an old answer.
+        self.cache.clear();
         if let Some(s) = alarm {
             let pdu = rt::abort(ar.alarm_remote, ALARM_REF, s);
             let f = eth::frame(

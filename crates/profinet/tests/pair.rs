@@ -1485,3 +1485,49 @@ fn cyclic_frames_follow_send_clock_times_reduction_ratio() {
         }
     }
 }
+
+#[test]
+fn a_device_accepts_a_new_connect_after_release_and_after_an_abort() {
+    let mut p = Pair::running(controller_config());
+    p.ctl.release(p.now).unwrap();
+    p.run_until(p.now + Duration::from_secs(2), |p| p.ctl.is_closed());
+    let mut second = controller_config();
+    second.ar_uuid.0[0] ^= 0xFF;
+    p.ctl = Controller::new(second.clone());
+    p.ctl.start(p.now);
+    let limit = p.now + Duration::from_secs(5);
+    assert!(
+        p.run_until(limit, |p| p.ctl.is_running()),
+        "after Release: {:?}",
+        p.ctl_events
+    );
+    // The controller falls silent: the device's watchdog ends the AR.
+    p.ctl.set_sending(false);
+    p.run_until(p.now + Duration::from_secs(1), |p| p.ctl.is_closed());
+    assert_eq!(p.dev.ar_state(), None);
+    second.ar_uuid.0[1] ^= 0xFF;
+    p.ctl = Controller::new(second);
+    p.ctl.start(p.now);
+    let limit = p.now + Duration::from_secs(5);
+    assert!(
+        p.run_until(limit, |p| p.ctl.is_running()),
+        "after the watchdog: {:?}",
+        p.ctl_events
+    );
+}
+
+#[test]
+fn the_same_controller_can_connect_again_after_release() {
+    let mut p = Pair::running(controller_config());
+    p.ctl.release(p.now).unwrap();
+    p.run_until(p.now + Duration::from_secs(2), |p| p.ctl.is_closed());
+    p.ctl = Controller::new(controller_config());
+    p.ctl.start(p.now);
+    let limit = p.now + Duration::from_secs(5);
+    assert!(
+        p.run_until(limit, |p| p.ctl.is_running()),
+        "{:?}",
+        p.ctl_events
+    );
+    assert_eq!(p.dev.ar_state(), Some(true));
+}
