@@ -75,7 +75,9 @@ pub struct ControllerConfig {
     pub app_ready_timeout: Duration,
     /// Records written between Connect and PrmEnd (index, data) on the output module.
     pub prm_records: Vec<(u16, Vec<u8>)>,
-    /// The AR's UUID.
+    /// The AR's UUID (its activity UUID is derived from it). [`ControllerConfig::new`] derives
+    /// one from the MAC, the same on every run; a caller that runs several ARs in a row may
+    /// set a fresh one for each.
     pub ar_uuid: Uuid,
     /// SessionKey.
     pub session_key: u16,
