@@ -7,7 +7,9 @@
 //! record Read/Write (IODReadReqHeader/ResHeader, IODWriteReqHeader/ResHeader, with the record
 //! data that follows the header block), and the control blocks (PrmEnd, ApplicationReady,
 //! Release, …). Any other block is kept as [`Block::Unknown`], skipped by its length, and
-//! listed by [`CmMessage::unknown_blocks`].
+//! listed by [`CmMessage::unknown_blocks`]; [`alarm_cr_req`], [`alarm_cr_res`] and
+//! [`module_diff`] read the AlarmCR and ModuleDiff blocks among them, and
+//! [`alarm_notification`] the notification in an alarm frame's var part.
 //!
 //! Element counts from the wire never size an allocation: every element is read from the
 //! body, so memory is bounded by the body. Decoding never panics.
@@ -1141,4 +1143,56 @@ pub fn module_diff(block: &UnknownBlock) -> Option<Result<ModuleDiff, PnioError>
         }
         Ok(ModuleDiff { modules })
     })
+}
+
+/// An alarm notification (IEC 61158-6-10 "AlarmNotification-PDU": BlockType 0x0001 low or
+/// 0x0002 high, AlarmType, API, slot, subslot, idents, AlarmSpecifier, then the items).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AlarmNote {
+    /// BlockType (0x0001 low, 0x0002 high).
+    pub block_type: u16,
+    /// AlarmType (1 diagnosis, 2 process, …).
+    pub alarm_type: u16,
+    /// API.
+    pub api: u32,
+    /// SlotNumber.
+    pub slot: u16,
+    /// SubslotNumber.
+    pub subslot: u16,
+    /// ModuleIdentNumber.
+    pub module_ident: u32,
+    /// SubmoduleIdentNumber.
+    pub submodule_ident: u32,
+    /// AlarmSpecifier (sequence number, channel or manufacturer diagnosis, …).
+    pub specifier: u16,
+    /// The alarm items after the specifier, to the end of the block.
+    pub items: Vec<u8>,
+}
+
+/// Reads the AlarmNotification block at the start of an RTA var part (IEC 61158-6-10
+/// DATA-RTA-PDU); `None` for another block or one that does not fit.
+pub fn alarm_notification(var: &[u8]) -> Option<AlarmNote> {
+    let mut r = Reader::new(var);
+    let block_type = r.be16().ok()?;
+    if !matches!(block_type, 0x0001 | 0x0002) {
+        return None;
+    }
+    let len = usize::from(r.be16().ok()?);
+    let body = r.take(len).ok()?;
+    let mut r = Reader::new(body);
+    r.skip(2).ok()?;
+    let read = |r: &mut Reader<'_>| -> Result<AlarmNote, Truncated> {
+        Ok(AlarmNote {
+            block_type,
+            alarm_type: r.be16()?,
+            api: r.be32()?,
+            slot: r.be16()?,
+            subslot: r.be16()?,
+            module_ident: r.be32()?,
+            submodule_ident: r.be32()?,
+            specifier: r.be16()?,
+            items: r.rest().to_vec(),
+        })
+    };
+    read(&mut r).ok()
 }

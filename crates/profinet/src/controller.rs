@@ -24,9 +24,9 @@ use crate::udp::{Endpoints, Ipv4};
 use drivespec_capture::dcerpc::{Header, PacketType, Uuid, PNIO_PORT};
 use drivespec_capture::link::ethertype;
 use drivespec_capture::pnio::{
-    alarm_cr_res, block_type, control_command, module_diff, AlarmCrBlockReq, ArBlockReq, Block,
-    BlockHeader, CmMessage, ControlBlock, ControlKind, DiffModule, Direction, FrameOffset, IocrApi,
-    IocrBlockReq, Operation, PnioStatus, RecordRequest,
+    alarm_cr_res, alarm_notification, block_type, control_command, module_diff, AlarmCrBlockReq,
+    AlarmNote, ArBlockReq, Block, BlockHeader, CmMessage, ControlBlock, ControlKind, DiffModule,
+    Direction, FrameOffset, IocrApi, IocrBlockReq, Operation, PnioStatus, RecordRequest,
 };
 use drivespec_capture::rt::{DataStatus, DcpHeader, FrameClass, FrameId};
 use std::collections::VecDeque;
@@ -206,62 +206,6 @@ pub enum ControllerEvent {
     Released,
     /// The controller stopped.
     Failed(ControllerError),
-}
-
-/// An alarm notification (IEC 61158-6-10 "AlarmNotification-PDU": BlockType 0x0001 low or
-/// 0x0002 high, AlarmType, API, slot, subslot, idents, AlarmSpecifier, then items).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct AlarmNote {
-    /// BlockType (0x0001 low, 0x0002 high).
-    pub block_type: u16,
-    /// AlarmType (1 diagnosis, 2 process, …).
-    pub alarm_type: u16,
-    /// API.
-    pub api: u32,
-    /// SlotNumber.
-    pub slot: u16,
-    /// SubslotNumber.
-    pub subslot: u16,
-    /// ModuleIdentNumber.
-    pub module_ident: u32,
-    /// SubmoduleIdentNumber.
-    pub submodule_ident: u32,
-    /// AlarmSpecifier (sequence number, channel/manufacturer diagnosis, …).
-    pub specifier: u16,
-    /// The alarm items after the specifier.
-    pub items: Vec<u8>,
-}
-
-impl AlarmNote {
-    /// Reads a notification block from an RTA var part; `None` if it is none.
-    fn parse(var: &[u8]) -> Option<AlarmNote> {
-        let be16 = |at: usize| {
-            var.get(at..at + 2)
-                .and_then(|b| <[u8; 2]>::try_from(b).ok())
-                .map(u16::from_be_bytes)
-        };
-        let be32 = |at: usize| {
-            var.get(at..at + 4)
-                .and_then(|b| <[u8; 4]>::try_from(b).ok())
-                .map(u32::from_be_bytes)
-        };
-        let block_type = be16(0)?;
-        if !matches!(block_type, 0x0001 | 0x0002) {
-            return None;
-        }
-        let end = 4 + usize::from(be16(2)?);
-        Some(AlarmNote {
-            block_type,
-            alarm_type: be16(6)?,
-            api: be32(8)?,
-            slot: be16(12)?,
-            subslot: be16(14)?,
-            module_ident: be32(16)?,
-            submodule_ident: be32(20)?,
-            specifier: be16(24)?,
-            items: var.get(26..end.max(26))?.to_vec(),
-        })
-    }
 }
 
 /// Sequence numbers of the alarm channel (IEC 61158-6-10 APMS/APMR: start 0xFFFF, then
@@ -1399,7 +1343,7 @@ impl Controller {
                 if !fresh {
                     return;
                 }
-                let Some(n) = AlarmNote::parse(a.var_part) else {
+                let Some(n) = alarm_notification(a.var_part) else {
                     return;
                 };
                 let mut body = Vec::with_capacity(16);
