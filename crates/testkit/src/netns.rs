@@ -15,7 +15,7 @@
 
 use std::io::{BufRead, BufReader, Read};
 use std::net::Ipv4Addr;
-use std::process::{Child, ChildStdout, Command, Stdio};
+use std::process::{Child, ChildStderr, ChildStdout, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Prefix of every namespace this module makes.
@@ -79,46 +79,87 @@ impl Netns {
     }
 }
 
-/// A process started in a namespace, killed when dropped; stdout is piped and read by line.
+/// A process started in a namespace, killed when dropped; stdout (and stderr, if piped) is
+/// read by line.
 #[derive(Debug)]
 pub struct NsChild {
     child: Child,
     stdout: BufReader<ChildStdout>,
+    stderr: Option<BufReader<ChildStderr>>,
 }
+
+/// How a process ended: its exit code (-1 when killed by a signal), the rest of its stdout
+/// and of its stderr (empty when inherited).
+pub type Ended = (i32, String, String);
 
 impl NsChild {
     /// Starts `c` with stdout piped and stderr inherited.
-    pub fn spawn(mut c: Command) -> Self {
+    pub fn spawn(c: Command) -> Self {
+        Self::start(c, false)
+    }
+
+    /// Starts `c` with stdout and stderr piped.
+    pub fn spawn_piped(c: Command) -> Self {
+        Self::start(c, true)
+    }
+
+    fn start(mut c: Command, pipe_stderr: bool) -> Self {
         let mut child = c
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
+            .stderr(if pipe_stderr {
+                Stdio::piped()
+            } else {
+                Stdio::inherit()
+            })
             .spawn()
             .expect("start a process in the namespace");
         let stdout = BufReader::new(child.stdout.take().expect("piped stdout"));
-        Self { child, stdout }
+        let stderr = child.stderr.take().map(BufReader::new);
+        Self {
+            child,
+            stdout,
+            stderr,
+        }
     }
 
     /// Reads stdout until a line containing `marker` (libtest may print its own words before
     /// it on the same line), and returns the rest of that line; panics when stdout ends first.
     pub fn wait_line(&mut self, marker: &str) -> String {
-        let mut line = String::new();
-        loop {
-            line.clear();
-            let n = self.stdout.read_line(&mut line).expect("read stdout");
-            assert!(n > 0, "the process ended before printing `{marker}`");
-            if let Some((_, rest)) = line.trim_end().split_once(marker) {
-                return rest.to_owned();
-            }
-        }
+        until(&mut self.stdout, marker, "stdout")
     }
 
-    /// Waits for the process to end; returns whether it succeeded and the rest of stdout.
-    pub fn finish(mut self) -> (bool, String) {
-        let mut rest = String::new();
-        let _ = self.stdout.read_to_string(&mut rest);
-        let ok = self.child.wait().expect("wait for the process").success();
-        (ok, rest)
+    /// As [`NsChild::wait_line`], on stderr (started with [`NsChild::spawn_piped`]).
+    pub fn wait_err_line(&mut self, marker: &str) -> String {
+        let err = self.stderr.as_mut().expect("stderr is piped");
+        until(err, marker, "stderr")
+    }
+
+    /// Waits for the process to end.
+    pub fn finish(mut self) -> Ended {
+        let mut out = String::new();
+        let _ = self.stdout.read_to_string(&mut out);
+        let mut err = String::new();
+        if let Some(e) = self.stderr.as_mut() {
+            let _ = e.read_to_string(&mut err);
+        }
+        let code = self.child.wait().expect("wait for the process").code();
+        (code.unwrap_or(-1), out, err)
+    }
+}
+
+fn until(r: &mut impl BufRead, marker: &str, what: &str) -> String {
+    let mut line = String::new();
+    loop {
+        line.clear();
+        let n = r.read_line(&mut line).expect("read the output");
+        assert!(
+            n > 0,
+            "the process ended before printing `{marker}` on {what}"
+        );
+        if let Some((_, rest)) = line.trim_end().split_once(marker) {
+            return rest.to_owned();
+        }
     }
 }
 

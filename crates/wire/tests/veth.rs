@@ -133,8 +133,8 @@ fn thousand_frames_cross_the_veth_pair_in_order() {
         "send",
         &[("DRIVESPEC_IFACE", &pair.a.iface), ("DRIVESPEC_DST", &dst)],
     );
-    let (sent, _) = tx.finish();
-    assert!(sent, "the sender failed");
+    let (code, _, _) = tx.finish();
+    assert_eq!(code, 0, "the sender failed");
     let result = rx.wait_line("result: ");
     println!("veth one-way, {FRAMES} frames at 1 ms: {result}");
     let mut words = result.split_whitespace();
