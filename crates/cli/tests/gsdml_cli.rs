@@ -300,3 +300,71 @@ fn validates_against_the_pi_schema_where_one_is_given() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// profinet-py's GSDML reader (an independent IO controller, installed by `.ci/run`) takes
+/// from the document the identity and the slots of `[protocol.profinet]`: the DAP with its
+/// submodules in slot 0, the 14-byte output module and the 16-byte input module of 3.5.
+#[test]
+fn profinet_py_reads_the_identity_and_slots() {
+    let dir = temp_dir("gsdml", "profinet-py");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("psd4xx.xml");
+    std::fs::write(&file, gsdml(&[])).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/gsdml_profinet_py.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .arg(&file)
+        .output();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let out = match out {
+        Ok(o) if o.status.code() != Some(3) => o,
+        _ => {
+            let msg = "profinet-py is not installed (python3 -m pip install profinet-py)";
+            assert!(
+                std::env::var_os("DRIVESPEC_REQUIRE_PROFINET_PY").is_none(),
+                "{msg}"
+            );
+            println!("skipping: {msg}");
+            return;
+        }
+    };
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let spec = Spec::builtin().unwrap();
+    let proto = spec.family(FamilyId::Psd4xx).psd4xx().unwrap();
+    let pn = &proto.profinet;
+    let mut want: Vec<serde_json::Value> = pn
+        .dap
+        .submodule
+        .iter()
+        .map(|s| serde_json::json!([pn.dap.slot, s.subslot, 0, 0, pn.dap.module_ident, s.ident]))
+        .collect();
+    let (o, i) = (&pn.output, &pn.input);
+    let (olen, ilen) = (
+        proto.process_data.output.length,
+        proto.process_data.input.length,
+    );
+    want.push(serde_json::json!([
+        o.slot,
+        o.subslot,
+        0,
+        olen,
+        o.module_ident,
+        o.submodule_ident
+    ]));
+    want.push(serde_json::json!([
+        i.slot,
+        i.subslot,
+        ilen,
+        0,
+        i.module_ident,
+        i.submodule_ident
+    ]));
+    assert_eq!(got["vendor_id"], pn.vendor_id);
+    assert_eq!(got["device_id"], pn.device_id);
+    assert_eq!(got["slots"], serde_json::Value::Array(want));
+}
