@@ -1346,8 +1346,15 @@ impl Device {
             || (slot, subslot) == (id.input.slot, id.input.subslot)
     }
 
+    /// The PNIOStatus of a refused record: ErrorDecode PNIORW, ErrorCode1 the class the
+    /// refusal falls in, ErrorCode2 (user specific, IEC 61158-6-10) the PKW error number of
+    /// manual 3.2.2 (0 for a wrong length), so a controller can tell every refusal apart.
     fn refusal(&self, code: u8, failure: RecordFailure) -> PnioStatus {
         let codes = self.drive.rules().pkw().error_codes();
+        let code2 = match failure {
+            RecordFailure::Refused { error } => u8::try_from(error.0).unwrap_or(u8::MAX),
+            RecordFailure::Malformed { .. } => 0,
+        };
         let c1 = match failure {
             RecordFailure::Malformed { .. } => rw::WRITE_LENGTH,
             RecordFailure::Refused { error } if error == codes.unknown_parameter => {
@@ -1357,7 +1364,7 @@ impl Device {
             RecordFailure::Refused { error } if error == codes.out_of_range => rw::INVALID_RANGE,
             RecordFailure::Refused { .. } => rw::INVALID_PARAMETER,
         };
-        status::status(code, status::PNIORW, c1, 0)
+        status::status(code, status::PNIORW, c1, code2)
     }
 
     fn drive_record(&mut self, req: DriveRecord) -> Option<Result<RecordAnswer, RecordFailure>> {
