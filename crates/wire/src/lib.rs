@@ -16,5 +16,5 @@ mod udp;
 
 pub use error::WireError;
 pub use filter::Filter;
-pub use raw::{Interface, OpenOptions, RawSocket, Received, MAX_FRAME, MIN_FRAME};
+pub use raw::{Interface, OpenOptions, RawSocket, Received, MAX_BATCH, MAX_FRAME, MIN_FRAME};
 pub use udp::bind_udp;

@@ -14,6 +14,9 @@ pub const MIN_FRAME: usize = 14;
 /// (IEEE 802.1Q 9.6), without FCS.
 pub const MAX_FRAME: usize = 1518;
 
+/// Most frames [`RawSocket::wait_frames`] hands on in one call.
+pub const MAX_BATCH: usize = 64;
+
 /// How long one wait for a frame lasts before the deadline of [`RawSocket::recv`] is looked
 /// at again. A choice: a frame is returned as soon as it arrives, so this bounds only how late
 /// a receive with no frame returns (at most this past its timeout) against the wake-ups of an
@@ -166,6 +169,35 @@ impl RawSocket {
                 "send",
                 io::Error::other("no send buffer"),
             )),
+        }
+    }
+
+    /// Hands every frame that passes the filter to `on_frame` as it arrives, until at least
+    /// one came or `until` passes; between two looks at the socket it sleeps at most `step`.
+    /// Returns the number of frames handed on, at most [`MAX_BATCH`] (a flood of frames
+    /// cannot keep the caller from its timers). For pacing finer than a millisecond (a cyclic
+    /// exchange), open the socket with a zero [`OpenOptions::poll`]: a look then never blocks,
+    /// and a frame waits at most `step` (plus the timer slack of the system) to be handed on.
+    pub fn wait_frames(
+        &mut self,
+        until: Instant,
+        step: Duration,
+        mut on_frame: impl FnMut(Received),
+    ) -> Result<usize, WireError> {
+        let mut n = 0usize;
+        loop {
+            while n < MAX_BATCH {
+                let Some(r) = self.recv(Duration::ZERO)? else {
+                    break;
+                };
+                on_frame(r);
+                n = n.saturating_add(1);
+            }
+            let now = Instant::now();
+            if n > 0 || now >= until {
+                return Ok(n);
+            }
+            std::thread::sleep(step.min(until.saturating_duration_since(now)));
         }
     }
 
