@@ -63,6 +63,9 @@ const DATA_HOLD_FACTOR: u16 = 256;
 /// state without saving to EEPROM (name and IP kept)" (manual 3.3), control byte 1 first.
 const DELIVERY_STATE: (u16, [u8; 3]) = (96, [0x01, 0xFF, 0xFF]);
 
+/// Pause before a failed start-up is tried again.
+const RETRY: Duration = Duration::from_millis(50);
+
 /// Longest wait for the answer to a Release.
 const RELEASE: Duration = Duration::from_secs(2);
 
@@ -243,8 +246,23 @@ impl ProfinetPeer {
         Ok(peer)
     }
 
-    /// A fresh controller: identify, connect, PrmEnd, ApplicationReady.
+    /// A fresh controller: identify, connect, PrmEnd, ApplicationReady. A refused or failed
+    /// start-up is tried again until [`START`] has passed: an AR this side could not release
+    /// (its controller failed) holds the device until the device's watchdog ends it.
     fn connect(&mut self) -> Result<(), PeerError> {
+        let deadline = Instant::now() + START;
+        loop {
+            match self.start_up(deadline) {
+                Ok(()) => break,
+                Err(e) if Instant::now() + RETRY >= deadline => return Err(e),
+                Err(_) => std::thread::sleep(RETRY),
+            }
+        }
+        self.base = Instant::now();
+        Ok(())
+    }
+
+    fn start_up(&mut self, deadline: Instant) -> Result<(), PeerError> {
         self.ars = self.ars.wrapping_add(1);
         let mut config =
             ControllerConfig::new(self.identity.clone(), self.mac, self.ip, &self.target);
@@ -267,12 +285,10 @@ impl ProfinetPeer {
             s.ctl.start(self.origin.elapsed());
         }
         self.wait(
-            Instant::now() + START,
+            deadline,
             "the start-up (Identify, Connect, PrmEnd, ApplicationReady)",
             |s| s.ctl.is_running(),
-        )?;
-        self.base = Instant::now();
-        Ok(())
+        )
     }
 
     /// Waits until `done` holds of the shared state; an error of the controller or the wire,
