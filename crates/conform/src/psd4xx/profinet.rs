@@ -251,12 +251,16 @@ impl ProfinetPeer {
     /// (its controller failed) holds the device until the device's watchdog ends it.
     fn connect(&mut self) -> Result<(), PeerError> {
         let deadline = Instant::now() + START;
-        loop {
-            match self.start_up(deadline) {
-                Ok(()) => break,
-                Err(e) if Instant::now() + RETRY >= deadline => return Err(e),
-                Err(_) => std::thread::sleep(RETRY),
+        while let Err(e) = self.start_up(deadline) {
+            // No station of that name (a case deleted it, par 96 = -3): trying again cannot help.
+            let gone = matches!(
+                lock(&self.shared).failed,
+                Some(ControllerError::NoSuchStation(_))
+            );
+            if gone || Instant::now() + RETRY >= deadline {
+                return Err(e);
             }
+            std::thread::sleep(RETRY);
         }
         self.base = Instant::now();
         Ok(())
