@@ -2,7 +2,7 @@
 //!
 //! - [`pcap`]: pcap and pcapng (plain or gzip-compressed) through one pull API on top of
 //!   `pcap-parser`'s streaming readers; [`write`](mod@write) writes them, for tests.
-//! - [`link`], [`ip`]: Ethernet (802.1Q, QinQ), Linux cooked captures, IPv4/UDP.
+//! - [`link`], [`ip`], [`arp`]: Ethernet (802.1Q, QinQ), Linux cooked captures, IPv4/UDP, ARP.
 //! - [`rt`]: PROFINET RT frames (FrameID classes, APDU status); [`dcerpc`] and [`pnio`]:
 //!   PNIO-CM calls over DCE/RPC; [`profinet`] ties them into [`profinet::Events`].
 //! - [`serial`]: HPD serial recordings (raw, socat dumps, our text format, serial pcaps) as
@@ -17,6 +17,7 @@
 //! read before them usable.
 #![forbid(unsafe_code)]
 
+pub mod arp;
 mod bytes;
 pub mod dcerpc;
 pub mod detect;

@@ -7,7 +7,9 @@
 //! record Read/Write (IODReadReqHeader/ResHeader, IODWriteReqHeader/ResHeader, with the record
 //! data that follows the header block), and the control blocks (PrmEnd, ApplicationReady,
 //! Release, …). Any other block is kept as [`Block::Unknown`], skipped by its length, and
-//! listed by [`CmMessage::unknown_blocks`].
+//! listed by [`CmMessage::unknown_blocks`]; [`alarm_cr_req`], [`alarm_cr_res`] and
+//! [`module_diff`] read the AlarmCR and ModuleDiff blocks among them, and
+//! [`alarm_notification`] the notification in an alarm frame's var part.
 //!
 //! Element counts from the wire never size an allocation: every element is read from the
 //! body, so memory is bounded by the body. Decoding never panics.
@@ -1000,4 +1002,197 @@ fn expected_submodule(r: &mut Reader<'_>) -> Result<ExpectedSubmodule, Truncated
         input,
         output,
     })
+}
+
+/// AlarmCRBlockReq (IEC 61158-6-10 "AlarmCRBlockReq"), read from a block kept as
+/// [`Block::Unknown`] by [`alarm_cr_req`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AlarmCrBlockReq {
+    /// AlarmCRType (1).
+    pub alarm_cr_type: u16,
+    /// LT (0x8892).
+    pub lt: u16,
+    /// AlarmCRProperties.
+    pub properties: u32,
+    /// RTATimeoutFactor (units of 100 ms).
+    pub rta_timeout_factor: u16,
+    /// RTARetries.
+    pub rta_retries: u16,
+    /// LocalAlarmReference of the initiator.
+    pub local_alarm_reference: u16,
+    /// MaxAlarmDataLength.
+    pub max_alarm_data_length: u16,
+    /// AlarmCRTagHeaderHigh.
+    pub tag_header_high: u16,
+    /// AlarmCRTagHeaderLow.
+    pub tag_header_low: u16,
+}
+
+/// AlarmCRBlockRes (IEC 61158-6-10 "AlarmCRBlockRes"), read by [`alarm_cr_res`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AlarmCrBlockRes {
+    /// AlarmCRType (1).
+    pub alarm_cr_type: u16,
+    /// LocalAlarmReference of the responder.
+    pub local_alarm_reference: u16,
+    /// MaxAlarmDataLength.
+    pub max_alarm_data_length: u16,
+}
+
+/// One submodule of a [`ModuleDiff`] (IEC 61158-6-10 "ModuleDiffBlock").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DiffSubmodule {
+    /// SubslotNumber.
+    pub subslot: u16,
+    /// SubmoduleIdentNumber of the real submodule.
+    pub ident: u32,
+    /// SubmoduleState (format 1: bits 11–14 IdentInfo, 7–10 ARInfo).
+    pub state: u16,
+}
+
+/// One module of a [`ModuleDiff`] (IEC 61158-6-10 "ModuleDiffBlock").
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DiffModule {
+    /// API.
+    pub api: u32,
+    /// SlotNumber.
+    pub slot: u16,
+    /// ModuleIdentNumber of the real module.
+    pub ident: u32,
+    /// ModuleState (0 no module, 1 wrong module, 2 proper module, 3 substitute).
+    pub state: u16,
+    /// The submodules that differ.
+    pub submodules: Vec<DiffSubmodule>,
+}
+
+/// ModuleDiffBlock (IEC 61158-6-10 "ModuleDiffBlock"), read by [`module_diff`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModuleDiff {
+    /// The modules that differ from the expected ones.
+    pub modules: Vec<DiffModule>,
+}
+
+fn typed<T>(
+    block: &UnknownBlock,
+    want: u16,
+    name: &'static str,
+    read: impl FnOnce(&mut Reader<'_>) -> Result<T, Truncated>,
+) -> Option<Result<T, PnioError>> {
+    if block.header.block_type != want {
+        return None;
+    }
+    let mut r = Reader::new(&block.body);
+    Some(read(&mut r).map_err(shifted(name, block.header.offset + 6)))
+}
+
+/// Reads an AlarmCRBlockReq kept as [`Block::Unknown`]; `None` for another block type.
+pub fn alarm_cr_req(block: &UnknownBlock) -> Option<Result<AlarmCrBlockReq, PnioError>> {
+    typed(block, block_type::ALARM_CR_REQ, "AlarmCRBlockReq", |r| {
+        Ok(AlarmCrBlockReq {
+            alarm_cr_type: r.be16()?,
+            lt: r.be16()?,
+            properties: r.be32()?,
+            rta_timeout_factor: r.be16()?,
+            rta_retries: r.be16()?,
+            local_alarm_reference: r.be16()?,
+            max_alarm_data_length: r.be16()?,
+            tag_header_high: r.be16()?,
+            tag_header_low: r.be16()?,
+        })
+    })
+}
+
+/// Reads an AlarmCRBlockRes kept as [`Block::Unknown`]; `None` for another block type.
+pub fn alarm_cr_res(block: &UnknownBlock) -> Option<Result<AlarmCrBlockRes, PnioError>> {
+    typed(block, block_type::ALARM_CR_RES, "AlarmCRBlockRes", |r| {
+        Ok(AlarmCrBlockRes {
+            alarm_cr_type: r.be16()?,
+            local_alarm_reference: r.be16()?,
+            max_alarm_data_length: r.be16()?,
+        })
+    })
+}
+
+/// Reads a ModuleDiffBlock kept as [`Block::Unknown`]; `None` for another block type. Counts
+/// never size an allocation: every element is read from the body.
+pub fn module_diff(block: &UnknownBlock) -> Option<Result<ModuleDiff, PnioError>> {
+    typed(block, block_type::MODULE_DIFF, "ModuleDiffBlock", |r| {
+        let mut modules = Vec::new();
+        for _ in 0..r.be16()? {
+            let api = r.be32()?;
+            for _ in 0..r.be16()? {
+                let slot = r.be16()?;
+                let ident = r.be32()?;
+                let state = r.be16()?;
+                let mut submodules = Vec::new();
+                for _ in 0..r.be16()? {
+                    submodules.push(DiffSubmodule {
+                        subslot: r.be16()?,
+                        ident: r.be32()?,
+                        state: r.be16()?,
+                    });
+                }
+                modules.push(DiffModule {
+                    api,
+                    slot,
+                    ident,
+                    state,
+                    submodules,
+                });
+            }
+        }
+        Ok(ModuleDiff { modules })
+    })
+}
+
+/// An alarm notification (IEC 61158-6-10 "AlarmNotification-PDU": BlockType 0x0001 low or
+/// 0x0002 high, AlarmType, API, slot, subslot, idents, AlarmSpecifier, then the items).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AlarmNote {
+    /// BlockType (0x0001 low, 0x0002 high).
+    pub block_type: u16,
+    /// AlarmType (1 diagnosis, 2 process, …).
+    pub alarm_type: u16,
+    /// API.
+    pub api: u32,
+    /// SlotNumber.
+    pub slot: u16,
+    /// SubslotNumber.
+    pub subslot: u16,
+    /// ModuleIdentNumber.
+    pub module_ident: u32,
+    /// SubmoduleIdentNumber.
+    pub submodule_ident: u32,
+    /// AlarmSpecifier (sequence number, channel or manufacturer diagnosis, …).
+    pub specifier: u16,
+    /// The alarm items after the specifier, to the end of the block.
+    pub items: Vec<u8>,
+}
+
+/// Reads the AlarmNotification block at the start of an RTA var part (IEC 61158-6-10
+/// DATA-RTA-PDU); `None` for another block or one that does not fit.
+pub fn alarm_notification(var: &[u8]) -> Option<AlarmNote> {
+    let mut r = Reader::new(var);
+    let block_type = r.be16().ok()?;
+    if !matches!(block_type, 0x0001 | 0x0002) {
+        return None;
+    }
+    let len = usize::from(r.be16().ok()?);
+    let body = r.take(len).ok()?;
+    let mut r = Reader::new(body);
+    r.skip(2).ok()?;
+    let read = |r: &mut Reader<'_>| -> Result<AlarmNote, Truncated> {
+        Ok(AlarmNote {
+            block_type,
+            alarm_type: r.be16()?,
+            api: r.be32()?,
+            slot: r.be16()?,
+            subslot: r.be16()?,
+            module_ident: r.be32()?,
+            submodule_ident: r.be32()?,
+            specifier: r.be16()?,
+            items: r.rest().to_vec(),
+        })
+    };
+    read(&mut r).ok()
 }

@@ -301,6 +301,68 @@ pub struct DcpHeader<'a> {
     pub blocks: &'a [u8],
 }
 
+/// One DCP block (IEC 61158-6-10 "DCP": Option, Suboption, DCPBlockLength, then
+/// BlockInfo or BlockQualifier where the service has one, and the data).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DcpBlock<'a> {
+    /// Option (1 IP, 2 device properties, 5 control, 6 device initiative, 0xFF all).
+    pub option: u8,
+    /// Suboption.
+    pub suboption: u8,
+    /// The DCPBlockLength bytes after the length field (BlockInfo or BlockQualifier first,
+    /// where present).
+    pub data: &'a [u8],
+}
+
+/// The blocks of a DCP PDU, each padded to an even length (our doc: module `rt`). Ends at
+/// the first block that does not fit.
+#[derive(Debug, Clone)]
+pub struct DcpBlocks<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Iterator for DcpBlocks<'a> {
+    type Item = Result<DcpBlock<'a>, Truncated>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.rest.is_empty() {
+            return None;
+        }
+        let mut r = Reader::new(self.rest);
+        let block = (|| {
+            let option = r.u8()?;
+            let suboption = r.u8()?;
+            let len = usize::from(r.be16()?);
+            let data = r.take(len)?;
+            if len % 2 == 1 && r.remaining() > 0 {
+                r.skip(1)?;
+            }
+            Ok(DcpBlock {
+                option,
+                suboption,
+                data,
+            })
+        })();
+        match block {
+            Ok(b) => {
+                self.rest = r.rest();
+                Some(Ok(b))
+            }
+            Err(e) => {
+                self.rest = &[];
+                Some(Err(e))
+            }
+        }
+    }
+}
+
+impl<'a> DcpHeader<'a> {
+    /// The blocks after the header.
+    pub fn iter_blocks(&self) -> DcpBlocks<'a> {
+        DcpBlocks { rest: self.blocks }
+    }
+}
+
 /// The RTA-PDU header of an alarm frame (IEC 61158-6-10 "RTA-PDU").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AlarmHeader<'a> {

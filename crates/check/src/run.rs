@@ -315,6 +315,61 @@ fn second_pass(path: &Path, c: &mut PnChecker<'_>) -> Result<(), RunError> {
     Ok(())
 }
 
+/// One Ethernet frame received from a live interface.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LiveFrame {
+    /// Microseconds since 1970 (UTC) when it was received.
+    pub time: u64,
+    /// The frame from its destination address on, without FCS.
+    pub data: Vec<u8>,
+}
+
+/// Runs the PROFINET checks on the Ethernet frames of `frames` as they arrive (`source`
+/// names the interface in the report), until it ends or `options.stop` is set; the report is
+/// the one a recording of the same frames gets. No second pass: a drive found late is
+/// checked from the frames kept since it appeared.
+pub fn check_frames(
+    spec: &Spec,
+    source: &str,
+    frames: impl IntoIterator<Item = LiveFrame>,
+    options: &RunOptions,
+) -> Result<Report, RunError> {
+    let (started, clock) = (std::time::SystemTime::now(), std::time::Instant::now());
+    if options.device.is_some_and(|d| d != Device::Psd4xx) {
+        return Err(unreadable(
+            Path::new(source),
+            "a live interface carries PROFINET: only --device psd4xx fits",
+        ));
+    }
+    let catalog = Arc::new(Catalog::new(spec).map_err(SetupError::from)?);
+    let mut pn = options.pn.clone();
+    pn.rescan = false;
+    let mut c = PnChecker::with_catalog(spec, pn, catalog)?;
+    let mut decoder = Decoder::default();
+    let mut counts = Counts::default();
+    let mut interrupted = false;
+    for (n, frame) in (1u64..).zip(frames) {
+        let pdu = decoder.decode(LinkType::ETHERNET, &frame.data);
+        counts.add(&pdu);
+        c.push_pdu(n, Some(frame.time), &pdu);
+        if options.stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
+    }
+    interrupted |= options.stop.load(Ordering::Relaxed);
+    c.end_of_input();
+    let mut report = c.finish(Some(counts));
+    report.file = Some(source.to_owned());
+    report.interrupted = interrupted;
+    report.timing = Some((started, clock.elapsed().as_secs_f64() * 1000.0));
+    report
+        .detection
+        .insert(0, format!("live capture on {source}, PSD4xx checks"));
+    report.judge(options.policy.clone());
+    Ok(report)
+}
+
 /// Checks one file (see the module docs); `progress` is called now and then.
 pub fn check_path(
     spec: &Spec,

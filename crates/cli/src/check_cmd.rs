@@ -10,7 +10,9 @@ use crate::interrupt::Interrupt;
 use crate::{Context, Format, Outcome};
 use anyhow::{anyhow, bail, Context as _, Result};
 use drivespec_check::profinet::Manual;
-use drivespec_check::run::{check_path, Device, InputFormat, Progress, RunOptions};
+use drivespec_check::run::{
+    check_frames, check_path, Device, InputFormat, LiveFrame, Progress, RunOptions,
+};
 use drivespec_check::{ndjson, render, Policy, Report};
 use drivespec_spec::hex::parse_int;
 use drivespec_spec::Spec;
@@ -20,6 +22,12 @@ use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Condvar, Mutex};
+use std::time::{Duration, Instant, UNIX_EPOCH};
+
+/// Longest wait for a frame before the stop flag and the `--duration` end are looked at
+/// again. A choice: Ctrl-C is noticed within it, and an idle interface costs 10 wake-ups a
+/// second.
+const LIVE_POLL: Duration = Duration::from_millis(100);
 
 /// Files finished but not yet printed, at most, per job.
 const WINDOW_PER_JOB: usize = 4;
@@ -37,8 +45,16 @@ pub struct CheckArgs {
     /// stands for the recordings in it and its subfolders (.pcap, .pcapng, .cap, .raw, .bin,
     /// .socat, .txt, .log, .jsonl, .csv, each also with .gz); files are reported sorted by
     /// path.
-    #[arg(required = true, value_name = "FILE|DIR")]
+    #[arg(required_unless_present = "live", value_name = "FILE|DIR")]
     files: Vec<PathBuf>,
+    /// Check the frames of this network interface as they arrive (a mirror port) instead of
+    /// recordings: PSD4xx checks, the same reports. Needs root or the capabilities
+    /// cap_net_raw,cap_net_admin+ep; Ctrl-C ends the check and reports what was received.
+    #[arg(long, value_name = "IFACE", conflicts_with_all = ["files", "jobs", "input_format"])]
+    live: Option<String>,
+    /// With --live: end the check after this long (`90s`, `10m`, `500ms`).
+    #[arg(long, value_name = "D", requires = "live", conflicts_with = "files", value_parser = crate::interrupt::parse_duration)]
+    duration: Option<Duration>,
     /// Files checked at the same time (default: the number of cores).
     #[arg(short = 'j', long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     jobs: Option<u16>,
@@ -462,6 +478,9 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
         || std::thread::available_parallelism().map_or(1, usize::from),
         usize::from,
     );
+    if let Some(iface) = &args.live {
+        return run_live(iface, &spec, &args, &options, &interrupt, format);
+    }
     let mut sink = Sink::new(format, args.report_dir.is_some());
     let files = expand(&args.files, &mut sink.errors);
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");
@@ -519,7 +538,13 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
         Ok(())
     });
     printed?;
-    sink.finish(files.len())?;
+    conclude(&sink, files.len(), &args, &interrupt)
+}
+
+/// Prints the end of the run, writes `--report-dir` and gives the outcome (stopped, setup
+/// error, pass or fail).
+fn conclude(sink: &Sink, files: usize, args: &CheckArgs, interrupt: &Interrupt) -> Result<Outcome> {
+    sink.finish(files)?;
     if let Some(dir) = &args.report_dir {
         write_reports(dir, &sink.kept)?;
     }
@@ -535,4 +560,57 @@ pub fn run(args: CheckArgs, ctx: &Context) -> Result<Outcome> {
     } else {
         Outcome::Fail
     })
+}
+
+/// `drivespec check --live IFACE`: the frames of the interface, checked as they arrive until
+/// `--duration` ends or a signal stops the run.
+fn run_live(
+    iface: &str,
+    spec: &Spec,
+    args: &CheckArgs,
+    options: &RunOptions,
+    interrupt: &Interrupt,
+    format: ReportArg,
+) -> Result<Outcome> {
+    let mut sock = drivespec_wire::RawSocket::open(iface, drivespec_wire::OpenOptions::default())?;
+    let deadline = args.duration.map(|d| Instant::now() + d);
+    eprintln!(
+        "drivespec: checking the frames on {iface}{}",
+        match args.duration {
+            Some(d) => format!(" for {} ms", d.as_millis()),
+            None => " until Ctrl-C".to_owned(),
+        }
+    );
+    let mut failure = None;
+    let frames = std::iter::from_fn(|| loop {
+        if options.stop.load(Ordering::Relaxed) {
+            return None;
+        }
+        let wait = match deadline {
+            Some(d) => d.checked_duration_since(Instant::now())?.min(LIVE_POLL),
+            None => LIVE_POLL,
+        };
+        match sock.recv(wait) {
+            Ok(Some(r)) => {
+                let time = r.at.duration_since(UNIX_EPOCH).unwrap_or_default();
+                let time = u64::try_from(time.as_micros()).unwrap_or(u64::MAX);
+                return Some(LiveFrame {
+                    time,
+                    data: r.frame,
+                });
+            }
+            Ok(None) => continue,
+            Err(e) => {
+                failure = Some(e);
+                return None;
+            }
+        }
+    });
+    let report = check_frames(spec, iface, frames, options)?;
+    let mut sink = Sink::new(format, args.report_dir.is_some());
+    sink.take(Path::new(iface), Ok(report))?;
+    if let Some(e) = failure {
+        sink.errors.push(e.to_string());
+    }
+    conclude(&sink, 1, args, interrupt)
 }

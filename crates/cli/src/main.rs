@@ -29,6 +29,7 @@ mod interrupt;
 mod man_cmd;
 mod pd_cmd;
 mod sim_cmd;
+mod sim_profinet;
 mod simrun_cmd;
 mod spec_build;
 mod spec_cmd;

@@ -10,9 +10,10 @@ use std::net::TcpListener;
 use std::sync::Arc;
 use std::time::Duration;
 
-/// Serve a reference model to masters and PLC drivers on TCP, a pseudo-terminal or stdio.
+/// Serve a reference model to masters and PLC drivers on TCP, a pseudo-terminal, stdio or
+/// (psd4xx) as a PROFINET IO device on a network interface.
 #[derive(clap::Args)]
-#[command(group(clap::ArgGroup::new("transport").required(true).args(["listen", "pty", "stdio"])))]
+#[command(group(clap::ArgGroup::new("transport").required(true).args(["listen", "pty", "stdio", "profinet"])))]
 pub struct SimArgs {
     /// Device family: hpd (serial protocol), psd4xx or psx3xx (cyclic-exchange protocol).
     device: String,
@@ -34,6 +35,18 @@ pub struct SimArgs {
     /// Requests on stdin, answers on stdout (an `exec:` device under test).
     #[arg(long)]
     stdio: bool,
+    /// psd4xx: a PROFINET IO device (DCP, PNIO-CM, RT class 1) on this network interface;
+    /// needs root or cap_net_raw,cap_net_admin.
+    #[arg(long, value_name = "IFACE")]
+    profinet: Option<String>,
+    /// NameOfStation of the PROFINET IO device (--profinet).
+    #[arg(
+        long,
+        value_name = "NAME",
+        default_value = "drivespec-sim",
+        requires = "profinet"
+    )]
+    name: String,
     /// Probability (0–1) that an answer is not sent.
     #[arg(long, value_name = "P", default_value_t = 0.0)]
     drop_answers: f64,
@@ -83,6 +96,9 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
         seed: args.seed,
     };
     faults.check()?;
+    if let Some(iface) = &args.profinet {
+        return run_profinet(&args, ctx, family, iface, faults, time_limit);
+    }
     if family != FamilyId::Hpd {
         return run_cyclic(&args, ctx, family, faults, time_limit);
     }
@@ -142,6 +158,46 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
     };
     print_stats(&mut log, &stats);
     Ok(Outcome::Pass)
+}
+
+/// `drivespec sim psd4xx --profinet IFACE`.
+fn run_profinet(
+    args: &SimArgs,
+    ctx: &Context,
+    family: FamilyId,
+    iface: &str,
+    faults: Faults,
+    time_limit: Option<Duration>,
+) -> Result<Outcome> {
+    if family != FamilyId::Psd4xx {
+        bail!(
+            "--profinet is for psd4xx (a PROFINET IO device); {family} has no PROFINET interface"
+        );
+    }
+    let Faults {
+        drop_answers,
+        corrupt_checksums,
+        corrupt_images,
+        delay_us,
+        ..
+    } = faults;
+    if drop_answers > 0.0 || corrupt_checksums > 0.0 || corrupt_images > 0.0 || delay_us > 0 {
+        bail!("--drop-answers, --corrupt-* and --delay-ms are for the drivespec-cyclic/1 transports, not --profinet");
+    }
+    if args.baud_code.is_some() || args.addr != 0 || args.any_bit_rate {
+        bail!("--baud-code, --addr and --any-bit-rate are for hpd (serial line)");
+    }
+    let spec = ctx.spec()?;
+    crate::sim_profinet::run(
+        &spec,
+        &crate::sim_profinet::ProfinetSim {
+            iface,
+            name: &args.name,
+            model: args.model.as_deref(),
+            log: args.log,
+            time_limit,
+        },
+    )
 }
 
 /// `drivespec sim psd4xx|psx3xx`: the family's cyclic server on tcp, a pty or stdio.

@@ -58,6 +58,17 @@ enum SpecCommand {
         /// hpd, psd4xx or psx3xx.
         device: String,
     },
+    /// Write the GSDML device description (XML) of a PROFINET family to stdout or a file.
+    Gsdml {
+        /// psd4xx (the PROFINET family).
+        device: String,
+        /// Parameter ranges and defaults of this device model (default: the simulator's).
+        #[arg(long)]
+        model: Option<String>,
+        /// Write to this file instead of stdout.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
     /// Validate the spec and build every suite's cases and every simulator from it; one line
     /// per problem, exit 1 when there is any.
     Check,
@@ -105,6 +116,28 @@ pub fn run(args: SpecArgs, ctx: &Context) -> Result<Outcome> {
         }
         SpecCommand::Examples { device } => examples(family(&spec, device)?, format),
         SpecCommand::Errata { device } => errata(family(&spec, device)?, format),
+        SpecCommand::Gsdml { device, model, out } => {
+            let family = family(&spec, device)?;
+            if family.psd4xx().is_none() {
+                bail!(drivespec_spec::gsdml::GsdmlError::NotProfinet(
+                    family.id().as_str().to_owned()
+                ));
+            }
+            let query = model
+                .as_deref()
+                .unwrap_or(drivespec_sim::reference::PSD4XX_DEFAULT_MODEL);
+            let model = model_arg(family, Some(query))?
+                .ok_or_else(|| anyhow!("unknown {} model {query:?}", family.id()))?;
+            let xml = drivespec_spec::gsdml::psd4xx(family, model)?;
+            match out {
+                Some(path) => {
+                    std::fs::write(path, &xml)
+                        .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))?;
+                    Ok(String::new())
+                }
+                None => Ok(xml),
+            }
+        }
         SpecCommand::Check => unreachable_check(),
     }?;
     say_raw!("{out}")?;

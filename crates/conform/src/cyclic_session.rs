@@ -373,7 +373,13 @@ pub(crate) fn peer<'p>(
         }
         Dut::Tcp { addr } => Box::new(LinkPeer::new(Box::new(TcpLink::connect(addr)?), TIMEOUT_US)),
         Dut::Exec { argv } => Box::new(LinkPeer::new(Box::new(ExecLink::spawn(argv)?), TIMEOUT_US)),
+        Dut::Profinet { .. } => return Err(profinet_is_psd4xx()),
     })
+}
+
+/// The setup error of `--dut profinet:` for a family without PROFINET.
+pub(crate) fn profinet_is_psd4xx() -> SetupError {
+    SetupError::Usage("--dut profinet:IFACE/NAME is for psd4xx (a PROFINET IO device)".to_owned())
 }
 
 /// A session of family `F` on one device under test.
@@ -597,6 +603,9 @@ struct Run<'r, 's, I, O> {
     open: Option<OpenPoint>,
     /// Live values read in a motion case.
     live: Vec<LiveRead>,
+    /// Why the case cannot be run on this device: an injection the reference takes and the
+    /// device answers `UNSUPPORTED` (optional, crates/cyclic/README.md); the case is skipped.
+    unsupported: Option<String>,
 }
 
 impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
@@ -704,6 +713,14 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             .as_ref()
             .filter(|g| run.tol.motion && same_length(&expected, g).is_some())
             .and_then(|g| self.family.live(&req, g));
+        if let (Request::Env { env, .. }, Some(Reply::Unsupported)) = (&req, &got) {
+            if expected != Reply::Unsupported {
+                run.unsupported = Some(format!(
+                    "step {step} ({text}): the device under test cannot take the injection `{env}` (ENV answered UNSUPPORTED)"
+                ));
+                return false;
+            }
+        }
         let (ok, remark) = match (&got, live) {
             (Some(g), Some((quantity, value))) => {
                 let as_reference = self.family.same_reply(&req, &expected, g, run.tol).0;
@@ -1451,6 +1468,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             arrivals: Vec::new(),
             open: F::open(case),
             live: Vec::new(),
+            unsupported: None,
         };
         let reset_ok = match self.device.call(&Request::Reset) {
             Ok(Reply::Ok) => Ok(()),
@@ -1529,9 +1547,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         CaseRun {
             findings,
             checked: self.checked(&run),
-            outcome: match run.failure {
-                Some(f) => Outcome::Fail(f),
-                None => Outcome::Pass,
+            outcome: match (run.failure, run.unsupported) {
+                (Some(f), _) => Outcome::Fail(f),
+                (None, Some(reason)) => Outcome::Skip { reason },
+                (None, None) => Outcome::Pass,
             },
             evidence: run.evidence,
             elapsed_us: run.t,

@@ -6,6 +6,7 @@
 //! | `serial:/dev/ttyUSB0?baud=57600` | a serial line, 8E1 (manual 4.1) |
 //! | `tcp:HOST:PORT` | a raw byte stream (ser2net, a simulator) |
 //! | `exec:COMMAND ARGS` | a subprocess speaking the protocol on stdin/stdout |
+//! | `profinet:IFACE/NAME` | a PSD4xx on the network: PROFINET IO device NAME reached on interface IFACE |
 
 pub use drivespec_link::shell_quote;
 use std::fmt;
@@ -36,6 +37,13 @@ pub enum Dut {
         /// Program and arguments, split like a shell does (quotes and backslashes).
         argv: Vec<String>,
     },
+    /// A PROFINET IO device on a network interface (PSD4xx bus description 3).
+    Profinet {
+        /// The network interface (`eth0`).
+        iface: String,
+        /// The device's NameOfStation.
+        name: String,
+    },
 }
 
 impl Default for Dut {
@@ -46,7 +54,7 @@ impl Default for Dut {
 
 /// Why a `--dut` text is not usable.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("--dut {text:?}: {why} (forms: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS')")]
+#[error("--dut {text:?}: {why} (forms: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS', profinet:IFACE/NAME)")]
 pub struct DutError {
     /// The text given.
     pub text: String,
@@ -76,6 +84,9 @@ pub enum DutProblem {
     /// `exec:` without a command.
     #[error("no command")]
     NoCommand,
+    /// `profinet:` without `IFACE/NAME`.
+    #[error("expected profinet:IFACE/NAME")]
+    NotIfaceName,
     /// Not `sim`, `serial`, `tcp` or `exec`.
     #[error("unknown transport")]
     UnknownTransport,
@@ -149,6 +160,13 @@ impl FromStr for Dut {
                 }
                 Ok(Dut::Exec { argv })
             }
+            "profinet" => match rest.trim().split_once('/') {
+                Some((iface, name)) if !iface.is_empty() && !name.is_empty() => Ok(Dut::Profinet {
+                    iface: iface.to_owned(),
+                    name: name.to_owned(),
+                }),
+                _ => Err(bad(DutProblem::NotIfaceName)),
+            },
             _ => Err(bad(DutProblem::UnknownTransport)),
         }
     }
@@ -169,6 +187,7 @@ impl fmt::Display for Dut {
                 let words: Vec<String> = argv.iter().map(|w| shell_quote(w)).collect();
                 write!(f, "exec:{}", words.join(" "))
             }
+            Dut::Profinet { iface, name } => write!(f, "profinet:{iface}/{name}"),
         }
     }
 }
@@ -275,9 +294,19 @@ mod tests {
             ("exec:\"x", SplitError::Unterminated('"').into()),
             ("exec:x\\", SplitError::TrailingBackslash.into()),
             ("usb:1", DutProblem::UnknownTransport),
+            ("profinet:eth0", DutProblem::NotIfaceName),
+            ("profinet:/psd", DutProblem::NotIfaceName),
+            ("profinet:eth0/", DutProblem::NotIfaceName),
         ] {
             assert_eq!(bad.parse::<Dut>().map_err(|e| e.why), Err(why), "{bad}");
         }
+        assert_eq!(
+            "profinet:veth0/psd-sim".parse::<Dut>().unwrap(),
+            Dut::Profinet {
+                iface: "veth0".into(),
+                name: "psd-sim".into()
+            }
+        );
         let e = "exec:'x".parse::<Dut>().unwrap_err().to_string();
         assert!(
             e.starts_with("--dut \"exec:'x\": unterminated ' quote ("),
@@ -293,6 +322,7 @@ mod tests {
             "serial:/dev/ttyS0?baud=9600",
             "tcp:127.0.0.1:9",
             "exec:python3 'a b.py'",
+            "profinet:eth1/psd-4",
         ] {
             let d: Dut = s.parse().unwrap();
             assert_eq!(d.to_string().parse::<Dut>().unwrap(), d);

@@ -12,6 +12,7 @@ mod erratum;
 mod error;
 mod family;
 mod files;
+pub mod gsdml;
 pub mod hex;
 mod load;
 mod model_values;

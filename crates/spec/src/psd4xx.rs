@@ -31,6 +31,8 @@ pub struct Protocol {
     pub leds: Vec<Led>,
     /// How the PROFINET device name is built (2.1).
     pub device_name: DeviceName,
+    /// PROFINET identity: vendor and device ID, slots and idents, I&M0 (2.1, 3.2.1).
+    pub profinet: PnIdentity,
     /// Generating the delivery state with the address switches (2.3).
     pub delivery_switch: DeliverySwitch,
     /// Numeric constants of the positioning functions (chapter 4).
@@ -529,6 +531,96 @@ pub enum LedPattern {
     On,
     /// Flashing (or flickering) at `hz`.
     Flashing,
+}
+
+/// The PROFINET identity of the device: what DCP answers, what a Connect expects and what
+/// the GSDML declares (manual 2.1, 3.2.1; the numbers are drivespec's own, see `source`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PnIdentity {
+    /// Where the numbers come from.
+    pub source: String,
+    /// VendorID (DCP DeviceID block, I&M0, GSDML `VendorID`).
+    pub vendor_id: u16,
+    /// DeviceID (DCP DeviceID block, GSDML `DeviceID`).
+    pub device_id: u16,
+    /// Vendor name (GSDML `VendorName`, DCP DeviceVendor).
+    pub vendor_name: String,
+    /// DCP DeviceRole (bit 0: IO device).
+    pub device_role: u8,
+    /// Instance in the PNIO object UUID (IEC 61158-6-10 "Object UUID").
+    pub instance: u16,
+    /// The device access point (slot 0 with its interface and port submodules).
+    pub dap: PnDap,
+    /// The 14-byte output module (3.2.1, 3.5.1).
+    pub output: PnModule,
+    /// The 16-byte input module (3.2.1, 3.5.2).
+    pub input: PnModule,
+    /// I&M0 record contents (IEC 61158-6-10 "I&M0").
+    pub im0: PnIm0,
+}
+
+/// The device access point (IEC 61158-6-10: slot 0, subslot 1 and the interface and port
+/// subslots 0x8000, 0x8001 …).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PnDap {
+    /// Slot of the DAP.
+    pub slot: u16,
+    /// ModuleIdentNumber of the DAP.
+    pub module_ident: u32,
+    /// The DAP's submodules, none with IO data.
+    pub submodule: Vec<PnSubmodule>,
+}
+
+/// One submodule without IO data (DAP, interface or port).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PnSubmodule {
+    /// SubslotNumber.
+    pub subslot: u16,
+    /// SubmoduleIdentNumber.
+    pub ident: u32,
+    /// What it is (GSDML name).
+    pub name: String,
+}
+
+/// A module with one IO submodule (3.2.1).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PnModule {
+    /// SlotNumber.
+    pub slot: u16,
+    /// SubslotNumber of its submodule.
+    pub subslot: u16,
+    /// ModuleIdentNumber.
+    pub module_ident: u32,
+    /// SubmoduleIdentNumber.
+    pub submodule_ident: u32,
+    /// Name (GSDML).
+    pub name: String,
+}
+
+/// I&M0 fields (IEC 61158-6-10 "I&M0"; order id and serial number come from the model).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PnIm0 {
+    /// IM_Hardware_Revision.
+    pub hardware_revision: u16,
+    /// IM_Software_Revision prefix (`V` released, `R`, `P`, `U`, `T`).
+    pub software_prefix: char,
+    /// IM_Software_Revision: functional enhancement, bug fix, internal change.
+    pub software_revision: [u8; 3],
+    /// IM_Revision_Counter.
+    pub revision_counter: u16,
+    /// IM_Profile_ID (0: no profile).
+    pub profile_id: u16,
+    /// IM_Profile_Specific_Type.
+    pub profile_specific_type: u16,
+    /// IM_Version: major, minor.
+    pub version: [u8; 2],
+    /// IM_Supported (bit list of I&M1–15).
+    pub supported: u16,
 }
 
 /// How the PROFINET device name is formed (2.1).

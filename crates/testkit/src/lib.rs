@@ -1,12 +1,15 @@
 //! Running the `drivespec` binary in the command-line tests: a run's exit code and output, a
-//! `drivespec sim` process that is killed when dropped, per-process temporary folders, and
-//! the checks of a `drivespec fuzz` run that finds nothing.
+//! `drivespec sim` process that is killed when dropped, per-process temporary folders,
+//! the checks of a `drivespec fuzz` run that finds nothing, and two network namespaces joined
+//! by a veth pair ([`netns`]).
 //!
 //! The binary's path comes from the test crate (`env!("CARGO_BIN_EXE_drivespec")`). Test
 //! code: a failure to start, feed or wait for the binary panics with the reason, which is how
 //! a test reports it; no input path of the product runs through this crate.
 #![forbid(unsafe_code)]
 #![allow(clippy::expect_used, clippy::unwrap_used, clippy::panic)]
+
+pub mod netns;
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::PathBuf;

@@ -211,6 +211,7 @@ impl<'s> HpdSuite<'s> {
             }
             Dut::Tcp { addr } => Box::new(TcpLink::connect(addr)?),
             Dut::Exec { argv } => Box::new(ExecLink::spawn(argv)?),
+            Dut::Profinet { .. } => return Err(crate::cyclic_session::profinet_is_psd4xx()),
         })
     }
 }

@@ -25,9 +25,11 @@
 //! judged.
 
 pub mod cases;
+mod profinet;
 mod scenario;
 mod session;
 
+pub use profinet::ProfinetPeer;
 pub use session::{Psd4xx, Psd4xxSession};
 
 use crate::case::CaseInfo;
@@ -131,6 +133,11 @@ impl<'s> Psd4xxSuite<'s> {
 
     /// The peer of the device under test `dut` (`sim`: the suite's reference drive).
     pub fn peer(&self, dut: &Dut) -> Result<Box<dyn Peer>, SetupError> {
+        if let Dut::Profinet { iface, name } = dut {
+            let identity = drivespec_profinet::Identity::from_spec(self.spec)
+                .map_err(|e| SetupError::Spec(e.to_string()))?;
+            return Ok(Box::new(ProfinetPeer::open(iface, name, identity)?));
+        }
         crate::cyclic_session::peer(dut, &self.reference.model.id, || self.server())
     }
 }
