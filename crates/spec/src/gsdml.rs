@@ -14,6 +14,7 @@
 
 use crate::psd4xx::{Field, Module, PnModule};
 use crate::{DataType, DeviceModel, Family, Parameter};
+use drivespec_report::escape;
 use std::fmt::Write as _;
 
 /// Smallest send clock the device accepts, in units of 31.25 µs (GSDML `MinDeviceInterval`,
@@ -557,19 +558,4 @@ impl Writer {
         }
         id.to_owned()
     }
-}
-
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
