@@ -350,16 +350,22 @@ fn data_item(w: &mut Writer, family: &Family, module: &str, f: &Field) {
         (4, true) => "Integer32",
         _ => "OctetString",
     };
-    let label = match &f.param {
-        Some(p) => format!("{} (par. {p}; bus description {})", f.label, f.source),
-        None => format!("{} (bus description {})", f.label, f.source),
-    };
-    let text = w.text(&format!("IDT_{module}_{}", f.name), &label);
     let bits: Vec<_> = f
         .param
         .as_deref()
         .map(|p| family.bitfields_of(p).flat_map(|b| &b.bits).collect())
         .unwrap_or_default();
+    let mut label = match &f.param {
+        Some(p) => format!("{} (par. {p}; bus description {})", f.label, f.source),
+        None => format!("{} (bus description {})", f.label, f.source),
+    };
+    if !bits.is_empty() && f.inverted {
+        label.push_str(
+            "; bits 0-7 in the first byte, 8-15 in the second (byte order inverted against \
+             the other fields)",
+        );
+    }
+    let text = w.text(&format!("IDT_{module}_{}", f.name), &label);
     let length = f.length.to_string();
     let mut attrs = vec![("DataType", data_type), ("TextId", text.as_str())];
     if data_type == "OctetString" {
