@@ -128,3 +128,52 @@ fn live_check_names_missing_interfaces_and_permissions() {
         _ => println!("skipping the permission case: no setpriv"),
     }
 }
+
+/// SIGINT ends a live check without `--duration` cleanly: the report of what was received and
+/// exit 130, as for an interrupted recording.
+#[test]
+fn sigint_ends_a_live_check_with_its_report() {
+    use std::io::{BufRead, BufReader, Read};
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(BIN)
+        .args(["check", "--live", "lo"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    err.read_line(&mut line).unwrap();
+    if line.contains("cap_net_raw") {
+        println!("skipping: {line}");
+        let _ = child.wait();
+        return;
+    }
+    assert!(
+        line.contains("checking the frames on lo until Ctrl-C"),
+        "{line}"
+    );
+    let pid = child.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let mut out = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
+    let mut rest = String::new();
+    err.read_to_string(&mut rest).unwrap();
+    let code = child.wait().unwrap().code();
+    assert_eq!(code, Some(130), "{out}{rest}");
+    assert!(
+        out.starts_with("lo [psd4xx]") && out.contains("interrupted"),
+        "{out}"
+    );
+    assert!(rest.contains("interrupted by SIGINT"), "{rest}");
+}

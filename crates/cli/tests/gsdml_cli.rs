@@ -207,6 +207,12 @@ fn psd4xx_gsdml_follows_the_rules() {
         "{xml}"
     );
     assert!(xml.contains("VendorID=\"0x0130\""), "{xml}");
+    // 3.5 notice: the bit-wise words name their byte order.
+    assert_eq!(
+        xml.matches("bits 0-7 in the first byte").count(),
+        2,
+        "{xml}"
+    );
 }
 
 #[test]

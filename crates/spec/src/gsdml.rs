@@ -14,6 +14,7 @@
 
 use crate::psd4xx::{Field, Module, PnModule};
 use crate::{DataType, DeviceModel, Family, Parameter};
+use drivespec_report::escape;
 use std::fmt::Write as _;
 
 /// Smallest send clock the device accepts, in units of 31.25 µs (GSDML `MinDeviceInterval`,
@@ -349,16 +350,22 @@ fn data_item(w: &mut Writer, family: &Family, module: &str, f: &Field) {
         (4, true) => "Integer32",
         _ => "OctetString",
     };
-    let label = match &f.param {
-        Some(p) => format!("{} (par. {p}; bus description {})", f.label, f.source),
-        None => format!("{} (bus description {})", f.label, f.source),
-    };
-    let text = w.text(&format!("IDT_{module}_{}", f.name), &label);
     let bits: Vec<_> = f
         .param
         .as_deref()
         .map(|p| family.bitfields_of(p).flat_map(|b| &b.bits).collect())
         .unwrap_or_default();
+    let mut label = match &f.param {
+        Some(p) => format!("{} (par. {p}; bus description {})", f.label, f.source),
+        None => format!("{} (bus description {})", f.label, f.source),
+    };
+    if !bits.is_empty() && f.inverted {
+        label.push_str(
+            "; bits 0-7 in the first byte, 8-15 in the second (byte order inverted against \
+             the other fields)",
+        );
+    }
+    let text = w.text(&format!("IDT_{module}_{}", f.name), &label);
     let length = f.length.to_string();
     let mut attrs = vec![("DataType", data_type), ("TextId", text.as_str())];
     if data_type == "OctetString" {
@@ -557,19 +564,4 @@ impl Writer {
         }
         id.to_owned()
     }
-}
-
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
