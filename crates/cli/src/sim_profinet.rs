@@ -70,6 +70,7 @@ pub fn run(spec: &Spec, sim: &ProfinetSim<'_>) -> Result<Outcome> {
         .skipping_source(mac),
         promiscuous: false,
         poll: Duration::ZERO,
+        ..OpenOptions::default()
     };
     let mut sock = RawSocket::open(sim.iface, options)?;
     // A bound PNIO-CM port keeps the kernel from answering the calls the device serves on

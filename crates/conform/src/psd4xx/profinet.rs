@@ -209,6 +209,7 @@ impl ProfinetPeer {
             .skipping_source(mac),
             promiscuous: false,
             poll: Duration::ZERO,
+            ..OpenOptions::default()
         };
         let sock = RawSocket::open(iface, options).map_err(|e| setup(e.to_string()))?;
         let quiet =
