@@ -126,6 +126,7 @@ fn every_psd4xx_variant_over_exec_passes_five_runs_in_a_row() {
 }
 
 #[test]
+#[ignore = "6 variants × 5 runs take about 1.5 minutes of real time with nothing beside them, too long for every CI run; run with --run-ignored"]
 fn every_psx3xx_variant_over_exec_passes_five_runs_in_a_row() {
     every_variant_five_runs(FamilyId::Psx3xx, workers());
 }
