@@ -4,8 +4,6 @@
 use crate::interrupt::Interrupt;
 use crate::Outcome;
 use anyhow::{anyhow, Context as _, Result};
-use drivespec_capture::arp;
-use drivespec_capture::link::ethertype;
 use drivespec_profinet::{Device, DeviceConfig, DeviceEvent};
 use drivespec_spec::{FamilyId, Spec};
 use drivespec_wire::{Filter, OpenOptions, RawSocket};
@@ -61,13 +59,8 @@ pub fn run(spec: &Spec, sim: &ProfinetSim<'_>) -> Result<Outcome> {
     }
     config.hello = true;
     let options = OpenOptions {
-        filter: Filter::ether_types(&[
-            ethertype::PROFINET,
-            ethertype::IPV4,
-            ethertype::VLAN,
-            arp::ETHERTYPE,
-        ])
-        .skipping_source(mac),
+        filter: Filter::ether_types(&drivespec_profinet::eth::STATION_ETHER_TYPES)
+            .skipping_source(mac),
         promiscuous: false,
         poll: Duration::ZERO,
         ..OpenOptions::default()

@@ -15,6 +15,8 @@
 //!
 //! These are test fixtures, not a library for users (unpublished): they are built from the
 //! built-in spec and end with a panic when it does not load.
+//! Their `unwrap`s read names and tables of the built-in spec or re-encode messages built
+//! from frames that decoded; none depends on what a runner sends them.
 #![forbid(unsafe_code)]
 #![allow(
     missing_docs,

@@ -4,6 +4,15 @@
 use crate::buf::Buf;
 pub use drivespec_capture::link::ethertype;
 
+/// The EtherTypes a PROFINET station receives: RT and DCP, IPv4 (PNIO-CM over UDP), VLAN-tagged
+/// frames and ARP (IEC 61158-6-10; RFC 826).
+pub const STATION_ETHER_TYPES: [u16; 4] = [
+    ethertype::PROFINET,
+    ethertype::IPV4,
+    ethertype::VLAN,
+    drivespec_capture::arp::ETHERTYPE,
+];
+
 /// A MAC address.
 pub type Mac = [u8; 6];
 

@@ -23,7 +23,6 @@
 use crate::cyclic::{Peer, PeerError, Reply, Request, VERSION};
 use crate::link::LinkError;
 use crate::suite::SetupError;
-use drivespec_capture::arp;
 use drivespec_capture::link::{ethertype, parse_ethernet};
 use drivespec_capture::pnio::PnioStatus;
 use drivespec_capture::rt::{FrameClass, RtFrame};
@@ -200,13 +199,8 @@ impl ProfinetPeer {
             .ok_or_else(|| setup(format!("network interface `{iface}` has no IPv4 address")))?
             .octets();
         let options = OpenOptions {
-            filter: Filter::ether_types(&[
-                ethertype::PROFINET,
-                ethertype::IPV4,
-                ethertype::VLAN,
-                arp::ETHERTYPE,
-            ])
-            .skipping_source(mac),
+            filter: Filter::ether_types(&drivespec_profinet::eth::STATION_ETHER_TYPES)
+                .skipping_source(mac),
             promiscuous: false,
             poll: Duration::ZERO,
             ..OpenOptions::default()
