@@ -318,13 +318,16 @@ pub trait CyclicFamily<'s> {
 /// not one that differs from the reference's shape.
 const RAMP_SLACK_PERCENT: i64 = 50;
 
-/// The steepest speed-up and slow-down per cycle (rpm) of a run's speeds, a sign change
-/// counted as slowing to 0 and speeding up from it.
-fn steepest(speeds: impl Iterator<Item = Option<i64>>) -> (i64, i64, Option<usize>, Option<usize>) {
+/// The steepest speed-up and slow-down per cycle (rpm) of a run's speeds (each with the
+/// time of its request and the time it was taken), a sign change counted as slowing to 0
+/// and speeding up from it.
+fn steepest(
+    speeds: impl Iterator<Item = Option<(i64, u64, u64)>>,
+) -> (i64, i64, Option<usize>, Option<usize>) {
     let (mut up, mut down, mut up_at, mut down_at) = (0i64, 0i64, None, None);
-    let mut last: Option<i64> = None;
+    let mut last: Option<(i64, u64, u64)> = None;
     for (i, v) in speeds.enumerate() {
-        if let (Some(a), Some(b)) = (last, v) {
+        if let (Some((a, t0, taken0)), Some((b, t1, taken1))) = (last, v) {
             let (slow, fast) = if a.signum() * b.signum() < 0 {
                 (a.abs(), b.abs())
             } else {
@@ -333,6 +336,18 @@ fn steepest(speeds: impl Iterator<Item = Option<i64>>) -> (i64, i64, Option<usiz
                     b.abs().saturating_sub(a.abs()).max(0),
                 )
             };
+            // Images taken further apart than their requests (a transport on real time)
+            // count per the requests' interval.
+            let (nominal, real) = (t1.saturating_sub(t0), taken1.saturating_sub(taken0));
+            let per = |x: i64| {
+                if real > nominal && nominal > 0 {
+                    let scaled = i128::from(x) * i128::from(nominal) / i128::from(real);
+                    i64::try_from(scaled).unwrap_or(x)
+                } else {
+                    x
+                }
+            };
+            let (slow, fast) = (per(slow), per(fast));
             if fast > up {
                 (up, up_at) = (fast, Some(i));
             }
@@ -498,8 +513,8 @@ struct Divergence<T> {
 
 /// The changes of `value` over `segment` (cycles numbered from `from`, `before` the cycle
 /// ahead of it) on the device and on the reference, values for which `skip` holds left out: the first change that differs in
-/// value, or that the device makes in an earlier step than the reference (a reaction may
-/// come later than the reference's, never before its stimulus).
+/// value, or that the device makes in a step before the stimulus of the reference's (a
+/// reaction may come later than the reference's, never before its stimulus).
 fn first_difference<I, T: PartialEq + Clone>(
     before: Option<&Cycle<I>>,
     segment: &[Cycle<I>],
@@ -522,13 +537,24 @@ fn first_difference<I, T: PartialEq + Clone>(
         out
     };
     // Both sides start from what they showed before the segment; the first segment starts
-    // from what the device showed first (the state both had before the first stimulus).
+    // from what the device showed first (the state both had before the first stimulus),
+    // unless that is the `lead` value (a run) the reference only reaches later: then the
+    // device had already reacted to the first stimulus when it answered (its image taken
+    // after the output reached it), and both start from the reference's first.
     let first = segment
         .first()
         .and_then(|c| c.dut.as_ref().ok())
         .map(&value);
+    let reference_first = segment.first().map(|c| value(&c.reference));
+    let reacted = lead.is_some()
+        && first == lead
+        && first != reference_first
+        && segment
+            .iter()
+            .any(|c| first.as_ref() == Some(&value(&c.reference)));
     let (d_start, r_start) = match before {
         Some(c) => (c.dut.as_ref().ok().map(&value), Some(value(&c.reference))),
+        None if reacted => (reference_first.clone(), reference_first),
         None => (first.clone(), first),
     };
     let d = changes(
@@ -545,8 +571,18 @@ fn first_difference<I, T: PartialEq + Clone>(
             .enumerate()
             .map(|(i, c)| (i, c.step, &c.reference)),
     );
+    // The step of the stimulus of a reference's change: that of the cycle before it at the
+    // latest (the reference shows a reaction in the cycle after the output that caused it).
+    let stimulus = |y: &(usize, usize, T)| {
+        y.0.checked_sub(1)
+            .and_then(|i| i.checked_sub(from))
+            .and_then(|i| segment.get(i))
+            .or(before)
+            .map_or(y.1, |c| c.step)
+            .min(y.1)
+    };
     let k = (0..d.len().max(r.len())).find(|&k| match (d.get(k), r.get(k)) {
-        (Some(x), Some(y)) => x.2 != y.2 || (lead.as_ref() == Some(&x.2) && x.1 < y.1),
+        (Some(x), Some(y)) => x.2 != y.2 || (lead.as_ref() == Some(&x.2) && x.1 < stimulus(y)),
         (None, None) => false,
         _ => true,
     })?;
@@ -579,6 +615,8 @@ fn step_of<I>(cycles: &[Cycle<I>], at: Option<usize>) -> String {
 struct Cycle<I> {
     step: usize,
     t: u64,
+    /// When the device's image was taken (µs; `t` on virtual time).
+    taken: u64,
     reference: I,
     dut: Result<I, String>,
 }
@@ -674,6 +712,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 run.cycles.push(Cycle {
                     step,
                     t: run.t,
+                    taken: run.t,
                     reference,
                     dut: Err(e.to_string()),
                 });
@@ -683,6 +722,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         run.cycles.push(Cycle {
             step,
             t: run.t,
+            taken: self.device.taken_at().unwrap_or(run.t),
             reference,
             dut,
         });
@@ -1224,12 +1264,15 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         }
         // The ramps: no speed change per cycle steeper than the reference's plus slack.
         if let Some([accel, decel]) = self.family.ramp_requirements() {
-            let (up, down, _, _) =
-                steepest(run.cycles.iter().map(|c| Some(F::motion(&c.reference).1)));
+            let (up, down, _, _) = steepest(
+                run.cycles
+                    .iter()
+                    .map(|c| Some((F::motion(&c.reference).1, c.t, c.t))),
+            );
             let (dev_up, dev_down, up_at, down_at) = steepest(
                 run.cycles
                     .iter()
-                    .map(|c| c.dut.as_ref().ok().map(|d| F::motion(d).1)),
+                    .map(|c| c.dut.as_ref().ok().map(|d| (F::motion(d).1, c.t, c.taken))),
             );
             let bound = |r: i64| {
                 r.saturating_mul(100 + RAMP_SLACK_PERCENT)

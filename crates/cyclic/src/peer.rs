@@ -40,6 +40,11 @@ pub trait Peer: Send {
     fn call(&mut self, req: &Request) -> Result<Reply, PeerError>;
     /// Reconnects or restarts after an error.
     fn recover(&mut self) -> Result<(), PeerError>;
+    /// When the input image of the last `CYCLE` was taken, µs on the request's clock, where
+    /// that is not the request's own time (a device on real time); `None` where it is.
+    fn taken_at(&self) -> Option<u64> {
+        None
+    }
 }
 
 /// The device side in the same process: lines go straight to a [`Server`].

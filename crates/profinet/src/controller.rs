@@ -57,6 +57,9 @@ pub struct ControllerConfig {
     pub target: String,
     /// IP to give the device by DCP Set when it has none.
     pub device_ip: Option<(Ipv4, Ipv4, Ipv4)>,
+    /// The device (MAC) to give the NameOfStation `target` by DCP Set when no station
+    /// answers the Identify for that name: a controller that knows its device by address.
+    pub name_device: Option<Mac>,
     /// The device's modules.
     pub identity: Identity,
     /// SendClockFactor (units of 31.25 µs; 32 = 1 ms).
@@ -106,6 +109,7 @@ impl ControllerConfig {
             station_name: "drivespec-controller".to_owned(),
             target: target.to_owned(),
             device_ip: None,
+            name_device: None,
             identity,
             send_clock_factor: 32,
             reduction_ratio: 1,
@@ -265,6 +269,7 @@ pub struct InputData {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum CallKind {
     SetIp,
+    SetName,
     Connect,
     Prm,
     PrmEnd,
@@ -273,9 +278,14 @@ enum CallKind {
 }
 
 impl CallKind {
+    /// Whether the call is a DCP Set (answered by DCP, not by RPC).
+    fn is_dcp(self) -> bool {
+        matches!(self, CallKind::SetIp | CallKind::SetName)
+    }
+
     fn name(self) -> &'static str {
         match self {
-            CallKind::SetIp => "DCP Set",
+            CallKind::SetIp | CallKind::SetName => "DCP Set",
             CallKind::Connect => "Connect",
             CallKind::Prm => "Write (parameterisation)",
             CallKind::PrmEnd => "Control PrmEnd",
@@ -328,6 +338,8 @@ pub struct Controller {
     events: VecDeque<ControllerEvent>,
     calls: VecDeque<Call>,
     sequence: u32,
+    /// The name was given by DCP Set once ([`ControllerConfig::name_device`]).
+    named: bool,
     next_record: u64,
     record_seq: u16,
     alarm_remote: Option<u16>,
@@ -372,6 +384,7 @@ impl Controller {
             events: VecDeque::new(),
             calls: VecDeque::new(),
             sequence: 0,
+            named: false,
             next_record: 0,
             record_seq: 0,
             alarm_remote: None,
@@ -591,9 +604,10 @@ impl Controller {
             {
                 let mine = self.device.is_some_and(|(d, _)| d == src)
                     && header.activity == self.activity()
-                    && self.calls.front().is_some_and(|c| {
-                        c.sequence == header.sequence && c.kind != CallKind::SetIp
-                    });
+                    && self
+                        .calls
+                        .front()
+                        .is_some_and(|c| c.sequence == header.sequence && !c.kind.is_dcp());
                 if mine {
                     let order = header.drep.integer;
                     let st = match body {
@@ -669,8 +683,16 @@ impl Controller {
         match self.state {
             State::Identify { deadline, tries } if now >= deadline => {
                 if tries >= self.config.rpc_retries {
-                    let name = self.config.target.clone();
-                    self.fail(ControllerError::NoSuchStation(name));
+                    match self.config.name_device.filter(|_| !self.named) {
+                        Some(mac) => {
+                            self.named = true;
+                            self.set_name(mac);
+                        }
+                        None => {
+                            let name = self.config.target.clone();
+                            self.fail(ControllerError::NoSuchStation(name));
+                        }
+                    }
                 } else {
                     self.identify(now, tries + 1);
                 }
@@ -809,7 +831,8 @@ impl Controller {
             }
             (State::Connecting, FrameClass::DcpGetSet, service::SET) => {
                 let Some(c) = self.calls.front() else { return };
-                if c.kind != CallKind::SetIp {
+                let kind = c.kind;
+                if !kind.is_dcp() {
                     return;
                 }
                 self.calls.pop_front();
@@ -819,10 +842,12 @@ impl Controller {
                     .find(|b| (b.option, b.suboption) == opt::CONTROL_RESPONSE)
                     .and_then(|b| b.data.get(2).copied())
                     .unwrap_or(0xFF);
-                if err == dcp::block_error::OK {
-                    self.connect();
-                } else {
+                if err != dcp::block_error::OK {
                     self.fail(ControllerError::DcpSet(err));
+                } else if kind == CallKind::SetName {
+                    self.identify(self.now, 0);
+                } else {
+                    self.connect();
                 }
             }
             _ => {}
@@ -830,13 +855,25 @@ impl Controller {
     }
 
     fn set_ip(&mut self, dev: Mac, ip: Ipv4, mask: Ipv4, gw: Ipv4) {
-        self.xid = self.xid.wrapping_add(1);
         let mut b = DcpBlocks::new();
         b.with_info(
             opt::IP_PARAMETER,
             dcp::PERMANENT,
             &dcp::ip_parameter(ip, mask, gw),
         );
+        self.dcp_set(dev, b, CallKind::SetIp);
+    }
+
+    /// Gives the device `dev` the NameOfStation `target` (IEC 61158-6-10 DCP Set).
+    fn set_name(&mut self, dev: Mac) {
+        let mut b = DcpBlocks::new();
+        let name = self.config.target.clone();
+        b.with_info(opt::NAME_OF_STATION, dcp::PERMANENT, name.as_bytes());
+        self.dcp_set(dev, b, CallKind::SetName);
+    }
+
+    fn dcp_set(&mut self, dev: Mac, b: DcpBlocks, kind: CallKind) {
+        self.xid = self.xid.wrapping_add(1);
         let pdu = dcp::pdu(
             FrameId::DCP_GET_SET,
             service::SET,
@@ -851,7 +888,7 @@ impl Controller {
         push(
             &mut self.calls,
             Call {
-                kind: CallKind::SetIp,
+                kind,
                 opnum: 0,
                 blocks: Vec::new(),
                 sequence: 0,
@@ -1073,7 +1110,7 @@ impl Controller {
         let Some(c) = self.calls.front_mut() else {
             return;
         };
-        if c.kind == CallKind::SetIp {
+        if c.kind.is_dcp() {
             return;
         }
         let body = cm::request(4096, &c.blocks, rpc::DREP.integer);
@@ -1093,9 +1130,7 @@ impl Controller {
         match (h.ptype, m.direction) {
             (PacketType::RESPONSE, Direction::Response) if ep.dst_port == CLIENT_PORT => {
                 let matches = self.calls.front().is_some_and(|c| {
-                    c.sequence == h.sequence
-                        && h.activity == self.activity()
-                        && c.kind != CallKind::SetIp
+                    c.sequence == h.sequence && h.activity == self.activity() && !c.kind.is_dcp()
                 });
                 if !matches {
                     return;
@@ -1124,7 +1159,7 @@ impl Controller {
             status: s,
         };
         match kind {
-            CallKind::SetIp => {}
+            CallKind::SetIp | CallKind::SetName => {}
             CallKind::Connect => {
                 if !st.is_ok() {
                     return self.fail(refused(st));

@@ -847,6 +847,32 @@ fn records_need_the_ar_and_an_existing_subslot() {
 }
 
 #[test]
+fn a_device_without_name_gets_it_by_dcp_set_from_a_controller_that_knows_its_mac() {
+    let mut c = DeviceConfig::new(spec(), "PSD426", DEV_MAC, "").unwrap();
+    c.ip = DEV_IP;
+    let mut unknown = Pair::new(controller_config());
+    unknown.dev = Device::new(spec(), c.clone()).unwrap();
+    unknown.run_until(Duration::from_secs(30), |p| p.ctl.is_closed());
+    assert_eq!(
+        unknown.ctl_events.last(),
+        Some(&ControllerEvent::Failed(ControllerError::NoSuchStation(
+            NAME.into()
+        )))
+    );
+    let mut cc = controller_config();
+    cc.name_device = Some(DEV_MAC);
+    let mut p = Pair::new(cc);
+    p.dev = Device::new(spec(), c).unwrap();
+    assert!(
+        p.run_until(Duration::from_secs(30), |p| p.ctl.is_running()),
+        "{:?}",
+        p.ctl_events
+    );
+    assert_eq!(p.dev.station_name(), NAME);
+    assert!(p.dev_events.contains(&DeviceEvent::NameSet(NAME.into())));
+}
+
+#[test]
 fn par_96_minus_3_deletes_the_station_name() {
     let mut p = Pair::running(controller_config());
     let id = Identity::from_spec(spec()).unwrap();

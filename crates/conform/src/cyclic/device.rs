@@ -24,6 +24,11 @@ impl<'a> Device<'a> {
         }
     }
 
+    /// When the input image of the last `CYCLE` was taken ([`Peer::taken_at`]).
+    pub(crate) fn taken_at(&self) -> Option<u64> {
+        self.peer.taken_at()
+    }
+
     /// What the peer is, one line.
     pub(crate) fn describe(&self) -> String {
         self.peer.describe()

@@ -40,6 +40,7 @@ use cases::PsdCase;
 use drivespec_psd4xx::model::{Drive, DriveConfig};
 use drivespec_sim::reference::{self, Reference};
 use drivespec_spec::{Family, FamilyId, Readings, Spec};
+use profinet::StartRecords;
 
 /// The device model `--model` selects when none is given.
 pub use drivespec_sim::reference::PSD4XX_DEFAULT_MODEL as DEFAULT_MODEL;
@@ -136,9 +137,70 @@ impl<'s> Psd4xxSuite<'s> {
         if let Dut::Profinet { iface, name } = dut {
             let identity = drivespec_profinet::Identity::from_spec(self.spec)
                 .map_err(|e| SetupError::Spec(e.to_string()))?;
-            return Ok(Box::new(ProfinetPeer::open(iface, name, identity)?));
+            let start = self.start_records().map_err(SetupError::Spec)?;
+            return Ok(Box::new(ProfinetPeer::open(iface, name, identity, start)?));
         }
         crate::cyclic_session::peer(dut, &self.reference.model.id, || self.server())
+    }
+
+    /// What brings a drive on the network to the state every case expects at its start
+    /// (3.3 par. 96): a reset as switching the control voltage off and on (a run stops), the
+    /// delivery state saved and the move to the middle of the range (the reference's start
+    /// position), then a reset again (the status word of power-on).
+    fn start_records(&self) -> Result<StartRecords, String> {
+        let p = self
+            .family
+            .psd4xx()
+            .ok_or_else(|| format!("{}: no PSD4xx protocol", self.family.id()))?;
+        let pos = &p.positioning;
+        let drive = &self.reference.drive;
+        let save = &pos.save.param;
+        let param = self
+            .family
+            .parameter(save)
+            .ok_or_else(|| format!("no par {save}"))?;
+        let index = u16::try_from(param.number).map_err(|e| format!("par {save}: {e}"))?;
+        let width = drivespec_psd4xx::Width::of_type(param.data_type)
+            .ok_or_else(|| format!("par {save} has no width"))?;
+        let command = |name: &str| -> Result<(u16, Vec<u8>), String> {
+            let value = param
+                .values
+                .iter()
+                .find(|v| v.name == name)
+                .ok_or_else(|| format!("par {save} has no value {name}"))?
+                .value;
+            let data = drivespec_psd4xx::RecordWrite {
+                index,
+                control: 1,
+                width,
+                value,
+            }
+            .to_bytes(drive.rules().record())
+            .map_err(|e| format!("record write of par {save}: {e}"))?;
+            Ok((index, data))
+        };
+        let number = |key: &str| {
+            self.family
+                .parameter(key)
+                .and_then(|p| u16::try_from(p.number).ok())
+                .and_then(|n| drive.parameter(n).ok())
+                .ok_or_else(|| format!("the reference has no par {key}"))
+        };
+        let start = number(&pos.mapping.actual_param)?;
+        let window = number(&pos.reference_loop.window_param)?;
+        let running = cases::status_bit(self.family, "Drive is running")?;
+        let rules = drive.rules().clone();
+        Ok(StartRecords {
+            restart: command("reset")?,
+            centre: command("delivery-state-and-centre")?,
+            settled: Box::new(move |image| {
+                drivespec_psd4xx::Input::parse(&rules, image).is_ok_and(|i| {
+                    i.status & running == 0
+                        && i.speed == 0
+                        && (i64::from(i.actual) - start).abs() <= window
+                })
+            }),
+        })
     }
 }
 

@@ -7,20 +7,19 @@
 //!
 //! | request | over PROFINET |
 //! | --- | --- |
-//! | `RESET` | Release, then identify and connect again, and write par 96 = -1 (the delivery state without saving, 3.3); the session clock restarts at 0 |
+//! | `RESET` | on a new AR, write par 96 = -6 (reset, as switching the control voltage off and on, 3.3); on the next, par 96 = -5 (delivery state saved, move to the middle of the range) and wait until the drive stands there; then par 96 = -6 again (the status word of power-on); the session clock restarts at 0 |
 //! | `CYCLE T OUT` | wait until the session time `T`, send `OUT` as the output image (3.5.1), let one full RT cycle pass both ways and answer the latest input image (3.5.2): the input of a `CYCLE` reflects the output after the RT round trip |
 //! | `ADVANCE T` | wait until `T` |
 //! | `READ T INDEX`, `WRITE T INDEX HEX` | wait until `T`, then the acyclic record Read or Write of `INDEX` on the output module's subslot (3.2.2) |
-//! | `ENV …` | `UNSUPPORTED`: a network cannot turn the shaft, cut the supply or drop the link |
+//! | `ENV T power-cycle 0` | wait until `T`, write par 96 = -6 ("reset the drive, as switching the control voltage off and on", 3.3), connect again |
+//! | other `ENV …` | `UNSUPPORTED`: a network cannot turn the shaft, cut the motor supply or drop the link |
 //!
 //! A refused record is answered by its PNIOStatus: ErrorCode1 `B1` (write length) is
 //! `MALFORMED`, any other PNIORW refusal `REFUSED` with the PKW error number of ErrorCode2
 //! (3.8), a state conflict (`B5`) `SILENT`. A write of control byte 0 that succeeds is
-//! `IGNORED` (3.2.2: the drive ignores the write). What par 96 = -1 does not restore stays
-//! across `RESET` as on a real drive: where the shaft stands and what the status word shows
-//! of the last case.
+//! `IGNORED` (3.2.2: the drive ignores the write).
 
-use crate::cyclic::{Peer, PeerError, Reply, Request, VERSION};
+use crate::cyclic::{Env, Peer, PeerError, Reply, Request, VERSION};
 use crate::link::LinkError;
 use crate::suite::SetupError;
 use drivespec_capture::link::{ethertype, parse_ethernet};
@@ -58,9 +57,14 @@ const ANSWER: Duration = Duration::from_secs(5);
 /// device that stops its frames is still noticed within a case.
 const DATA_HOLD_FACTOR: u16 = 256;
 
-/// The write record that restores the delivery state at `RESET`: par 96 = -1, "set delivery
-/// state without saving to EEPROM (name and IP kept)" (manual 3.3), control byte 1 first.
-const DELIVERY_STATE: (u16, [u8; 3]) = (96, [0x01, 0xFF, 0xFF]);
+/// Longest wait for the drive to stand at the start position after par 96 = -5: saving
+/// (up to 1 s, manual 4.7) and a run across the whole range of the largest model at a
+/// tenth of its delivery speed.
+const SETTLE: Duration = Duration::from_secs(30 * 60);
+
+/// Longest the input image may stand still, away from the start position, after par 96 =
+/// -5 before the drive counts as stopped elsewhere: above the save time (1 s, manual 4.7).
+const STALL: Duration = Duration::from_secs(5);
 
 /// Pause before a failed start-up is tried again.
 const RETRY: Duration = Duration::from_millis(50);
@@ -74,6 +78,19 @@ const IDLE: Duration = Duration::from_millis(10);
 /// Input frames to wait for after the first output frame carrying a new image: the first may
 /// have crossed it on the wire, the second left the device after it took the image.
 const ROUND_TRIP_FRAMES: u64 = 2;
+
+/// Whether an input image shows the drive settled at the start position.
+pub(crate) type Settled = Box<dyn Fn(&[u8]) -> bool + Send>;
+
+/// What `RESET` writes and waits for (module doc).
+pub(crate) struct StartRecords {
+    /// The write (index, data) that restarts the drive.
+    pub restart: (u16, Vec<u8>),
+    /// The write that restores and saves the delivery state and moves to the start position.
+    pub centre: (u16, Vec<u8>),
+    /// Whether an input image shows the drive settled at the start position.
+    pub settled: Settled,
+}
 
 /// What the exchange thread and the requests share.
 struct Shared {
@@ -103,8 +120,14 @@ pub struct ProfinetPeer {
     origin: Instant,
     /// Session time 0 (the last `RESET`).
     base: Instant,
+    /// When the input image of the last `CYCLE` was taken (session µs).
+    taken: Option<u64>,
     /// ARs made so far (each gets its own AR UUID and SessionKey).
     ars: u16,
+    /// The device's MAC once found: a case that deletes the name (par 96 = -3) leaves a
+    /// device the next start-up names again by DCP Set.
+    device: Option<[u8; 6]>,
+    start: StartRecords,
     shared: Arc<Mutex<Shared>>,
     thread: Option<JoinHandle<()>>,
     /// Keeps the kernel from answering the device's RPC answers with ICMP.
@@ -180,7 +203,12 @@ fn exchange(mut sock: RawSocket, origin: Instant, shared: &Mutex<Shared>) {
 impl ProfinetPeer {
     /// Opens interface `iface` and brings up an AR with the station named `target`; any
     /// failure is a setup error with its reason.
-    pub fn open(iface: &str, target: &str, identity: Identity) -> Result<ProfinetPeer, SetupError> {
+    pub(crate) fn open(
+        iface: &str,
+        target: &str,
+        identity: Identity,
+        start: StartRecords,
+    ) -> Result<ProfinetPeer, SetupError> {
         let what = format!("profinet:{iface}/{target}");
         let setup = |reason: String| {
             SetupError::Link(LinkError::Open {
@@ -232,12 +260,16 @@ impl ProfinetPeer {
             ip,
             origin,
             base: origin,
+            taken: None,
             ars: 0,
+            device: None,
+            start,
             shared,
             thread: Some(thread),
             _quiet: quiet,
         };
         peer.connect().map_err(|e| setup(e.to_string()))?;
+        peer.base = Instant::now();
         Ok(peer)
     }
 
@@ -247,7 +279,7 @@ impl ProfinetPeer {
     fn connect(&mut self) -> Result<(), PeerError> {
         let deadline = Instant::now() + START;
         while let Err(e) = self.start_up(deadline) {
-            // No station of that name (a case deleted it, par 96 = -3): trying again cannot help.
+            // No station of that name, and none to give it to: trying again cannot help.
             let gone = matches!(
                 lock(&self.shared).failed,
                 Some(ControllerError::NoSuchStation(_))
@@ -257,7 +289,6 @@ impl ProfinetPeer {
             }
             std::thread::sleep(RETRY);
         }
-        self.base = Instant::now();
         Ok(())
     }
 
@@ -276,6 +307,7 @@ impl ProfinetPeer {
         }
         config.session_key = self.ars;
         config.data_hold_factor = DATA_HOLD_FACTOR;
+        config.name_device = self.device;
         {
             let mut s = lock(&self.shared);
             s.ctl = Controller::new(config);
@@ -287,7 +319,9 @@ impl ProfinetPeer {
             deadline,
             "the start-up (Identify, Connect, PrmEnd, ApplicationReady)",
             |s| s.ctl.is_running(),
-        )
+        )?;
+        self.device = lock(&self.shared).ctl.device().map(|(mac, _)| mac);
+        Ok(())
     }
 
     /// Waits until `done` holds of the shared state; an error of the controller or the wire,
@@ -336,7 +370,32 @@ impl ProfinetPeer {
         })
     }
 
-    fn cycle(&self, t: u64, image: &[u8]) -> Result<Reply, PeerError> {
+    /// Restarts the drive (par 96 = reset) and makes a new AR: a real drive ends the AR
+    /// doing so.
+    fn restart(&mut self) -> Result<(), PeerError> {
+        self.reconnect()?;
+        let (index, data) = self.start.restart.clone();
+        // The drive restarts after its answer; one that restarts before gives none.
+        if let Ok(got) = self.record(0, index, Some(&data)) {
+            expect_written("par 96 = reset", got)?;
+        }
+        self.reconnect()
+    }
+
+    /// Releases the AR (if one is up) and makes a new one.
+    fn reconnect(&mut self) -> Result<(), PeerError> {
+        let released = lock(&self.shared)
+            .ctl
+            .release(self.origin.elapsed())
+            .is_ok();
+        if released {
+            // A release that fails still ends the AR on this side; connect anew.
+            let _ = self.wait(Instant::now() + RELEASE, "Release", |s| s.ctl.is_closed());
+        }
+        self.connect()
+    }
+
+    fn cycle(&mut self, t: u64, image: &[u8]) -> Result<Reply, PeerError> {
         let out = usize::from(self.identity.output.length);
         if image.len() != out {
             return Ok(Reply::Err(format!(
@@ -357,6 +416,7 @@ impl ProfinetPeer {
             }
             first.is_some_and(|n| s.ctl.input_frames() >= n.saturating_add(ROUND_TRIP_FRAMES))
         })?;
+        self.taken = u64::try_from(self.base.elapsed().as_micros()).ok();
         let s = lock(&self.shared);
         Ok(s.ctl
             .input()
@@ -417,6 +477,21 @@ impl Drop for ProfinetPeer {
     }
 }
 
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02X}")).collect()
+}
+
+/// `Ok` for a write the drive took; what `RESET` got otherwise.
+fn expect_written(what: &str, got: Reply) -> Result<(), PeerError> {
+    match got {
+        Reply::Written => Ok(()),
+        other => Err(PeerError::Garbage {
+            request: "RESET".to_owned(),
+            why: format!("{what} answered {other}"),
+        }),
+    }
+}
+
 /// The reply a refused record stands for (module doc).
 fn refused(s: PnioStatus) -> Reply {
     if s.decode != status::PNIORW {
@@ -444,25 +519,36 @@ impl Peer for ProfinetPeer {
                 "{family}: a PROFINET IO device is a psd4xx"
             ))),
             Request::Reset => {
-                let released = lock(&self.shared)
-                    .ctl
-                    .release(self.origin.elapsed())
-                    .is_ok();
-                if released {
-                    // A release that fails still ends the AR on this side; connect anew.
-                    let _ = self.wait(Instant::now() + RELEASE, "Release", |s| s.ctl.is_closed());
-                }
-                self.connect()?;
-                // Par 96 = -1: the delivery state without saving, name and IP kept (3.3).
-                match self.record(0, DELIVERY_STATE.0, Some(&DELIVERY_STATE.1))? {
-                    Reply::Written => {}
-                    other => {
-                        return Err(PeerError::Garbage {
-                            request: "RESET".to_owned(),
-                            why: format!("par 96 = -1 (delivery state) answered {other}"),
-                        })
+                self.restart()?;
+                let (index, data) = self.start.centre.clone();
+                let got = self.record(0, index, Some(&data))?;
+                expect_written("par 96 = delivery state and centre", got)?;
+                // Waits as long as the drive moves: a run across the whole range at the
+                // delivery speed takes minutes; a drive whose image stands still for
+                // [`STALL`] without being there has stopped elsewhere.
+                let settled = &self.start.settled;
+                let mut last = Vec::new();
+                let mut changed = Instant::now();
+                let moved = self.wait(Instant::now() + SETTLE, "", |s| {
+                    let image = s.ctl.input().map(|i| i.image.clone()).unwrap_or_default();
+                    if image != last {
+                        (last, changed) = (image, Instant::now());
                     }
+                    settled(&last) || changed.elapsed() > STALL
+                });
+                if moved.is_ok() && !settled(&last)
+                    || matches!(moved, Err(PeerError::Timeout { .. }))
+                {
+                    return Err(PeerError::Garbage {
+                        request: "RESET".to_owned(),
+                        why: format!(
+                            "the drive did not come to stand at the start position after par 96 = delivery state and centre; its last input image: {}",
+                            hex(&last)
+                        ),
+                    });
                 }
+                moved?;
+                self.restart()?;
                 self.base = Instant::now();
                 Ok(Reply::Ok)
             }
@@ -476,11 +562,23 @@ impl Peer for ProfinetPeer {
             Request::IsduRead { .. } | Request::IsduWrite { .. } => Ok(Reply::Err(
                 "ISDU requests are for psx3xx (IO-Link)".to_owned(),
             )),
+            Request::Env {
+                t,
+                env: Env::PowerCycle,
+            } => {
+                self.until(*t)?;
+                self.restart()?;
+                Ok(Reply::Ok)
+            }
             Request::Env { .. } => Ok(Reply::Unsupported),
         }
     }
 
     fn recover(&mut self) -> Result<(), PeerError> {
         self.connect()
+    }
+
+    fn taken_at(&self) -> Option<u64> {
+        self.taken
     }
 }
