@@ -51,6 +51,10 @@ pub const SEARCH_US: u64 = 10_000_000;
 /// Why a provider in STOP from its first frame is no violation of PN-RT-DS-002.
 const STARTUP_STOP: &str = "start-up: a provider reports STOP (DataStatus.ProviderState = 0) until its application runs; an IO controller sends STOP from its first cyclic frame until its program runs after ApplicationReady (IEC 61158-6-10 APDU_Status DataStatus bit 4)";
 
+/// Why a provider that goes from RUN to STOP and stays there until its AR is released is no
+/// violation of PN-RT-DS-002.
+const SHUTDOWN_STOP: &str = "shut-down: an IO controller goes to STOP (DataStatus.ProviderState = 0) and then releases the AR; STOP is an operating state of the provider (IEC 61158-6-10 APDU_Status DataStatus bit 4) whose device behaviour bus description 3.9 gives (CPU in \"Stop\" state)";
+
 /// Why a bad IOPS of a provider in STOP is no violation of PN-IO-IOPS-001.
 const BAD_IN_STOP: &str = "a provider in STOP marks its data bad (IOPS = Bad: CPU in \"Stop\" state, bus description 3.9; IEC 61158-6-10 IOxS)";
 
@@ -172,11 +176,14 @@ struct Stream {
     run_seen: bool,
     /// The listed start-up STOP, to be ended when the provider goes to RUN.
     stop_allowed: Option<usize>,
+    /// A STOP after RUN not judged yet: a violation when the provider goes back to RUN or
+    /// the capture ends, an allowed state when the AR is released first.
+    stop_pending: Option<(Where, Evidence)>,
     /// IOxS offsets whose bad value is listed as allowed (provider in STOP), to be ended.
     iox_allowed: Vec<(usize, Option<usize>)>,
-    /// Listed violations of the open conditions (DS-001, DS-002, DS-003, DS-004, TS-001,
-    /// LEN-001), to be ended.
-    open: [Option<usize>; 6],
+    /// Listed violations of the open conditions (DS-001, DS-003, DS-004, TS-001, LEN-001),
+    /// to be ended.
+    open: [Option<usize>; 5],
     problem: bool,
     reserved: bool,
     transfer: bool,
@@ -654,8 +661,9 @@ impl<'s> PnChecker<'s> {
                         stop: false,
                         run_seen: false,
                         stop_allowed: None,
+                        stop_pending: None,
                         iox_allowed: Vec::new(),
-                        open: [None; 6],
+                        open: [None; 5],
                         problem: false,
                         reserved: false,
                         transfer: false,
@@ -915,6 +923,29 @@ impl<'s> PnChecker<'s> {
         }
     }
 
+    /// Lists the STOP of the streams between `a` and `b` that went from RUN to STOP and are
+    /// still in STOP as allowed (a controller shutting down, PN-RT-DS-002), ended by the
+    /// Release at `at`.
+    fn released_in_stop(&mut self, a: [u8; 6], b: [u8; 6], at: Where) {
+        for ((_, src, dst), s) in &mut self.streams {
+            if pair(*src, *dst) != pair(a, b) {
+                continue;
+            }
+            if let Some((start, _)) = s.stop_pending.take() {
+                let i = self.rec.allowed(
+                    "PN-RT-DS-002",
+                    &s.label,
+                    start,
+                    "provider in STOP from RUN until the Release of its AR (shut-down)",
+                    SHUTDOWN_STOP,
+                );
+                if let Some(i) = i {
+                    self.rec.ended(i, at);
+                }
+            }
+        }
+    }
+
     /// The latest AR between two stations (either initiator), in words, and the time of
     /// its Connect.
     fn ar_between(&self, a: [u8; 6], b: [u8; 6]) -> Option<(String, Option<u64>)> {
@@ -1019,8 +1050,11 @@ impl<'s> PnChecker<'s> {
                             self.rec
                                 .report()
                                 .note(format!("AR {} released at {at}", c.ar_uuid));
-                            if let (Some(a), Some(b), Some(t)) = (ev.src, ev.dst, ev.time) {
-                                self.end_ar(a, b, t);
+                            if let (Some(a), Some(b)) = (ev.src, ev.dst) {
+                                self.released_in_stop(a, b, at);
+                                if let Some(t) = ev.time {
+                                    self.end_ar(a, b, t);
+                                }
                             }
                         }
                     }
@@ -1479,6 +1513,11 @@ impl<'s> PnChecker<'s> {
         let end = self.last_time;
         self.pn_events.finish(&mut self.rec, end);
         self.stopped_streams(end);
+        for (_, s) in &mut self.streams {
+            if let Some((start, evidence)) = s.stop_pending.take() {
+                stop_after_run(&mut self.rec, &s.label, start, evidence, None);
+            }
+        }
         self.unanswered_connects(end);
         let mut streams: Vec<(StreamKey, Stream)> = std::mem::take(&mut self.streams);
         streams.sort_by_key(|(k, _)| *k);
@@ -1533,6 +1572,27 @@ impl<'s> PnChecker<'s> {
     }
 }
 
+/// Records the STOP after RUN of stream `label` from `start` (PN-RT-DS-002), ended at `end`
+/// when the provider went back to RUN.
+fn stop_after_run(
+    rec: &mut Recorder,
+    label: &str,
+    start: Where,
+    evidence: Evidence,
+    end: Option<Where>,
+) {
+    let i = rec.violation(
+        "PN-RT-DS-002",
+        label,
+        start,
+        "provider went from RUN to STOP",
+        evidence,
+    );
+    if let (Some(i), Some(end)) = (i, end) {
+        rec.violation_ended(i, end);
+    }
+}
+
 /// A pair of stations in a fixed order.
 fn pair(a: [u8; 6], b: [u8; 6]) -> ([u8; 6], [u8; 6]) {
     if a <= b {
@@ -1548,7 +1608,7 @@ fn pair(a: [u8; 6], b: [u8; 6]) -> ([u8; 6], [u8; 6]) {
 fn condition(
     rec: &mut Recorder,
     label: &str,
-    open: &mut [Option<usize>; 6],
+    open: &mut [Option<usize>; 5],
     k: usize,
     now: bool,
     was: bool,
@@ -1709,25 +1769,22 @@ fn stream_frame(
         ("PN-RT-DS-001", "DataValid cleared after valid data".into())
     });
     let stop = !ds.provider_run();
-    cond(1, stop && s.run_seen, s.stop && s.run_seen, &|| {
-        ("PN-RT-DS-002", "provider went from RUN to STOP".into())
-    });
     let problem = !ds.station_ok();
-    cond(2, problem, s.problem, &|| {
+    cond(1, problem, s.problem, &|| {
         (
             "PN-RT-DS-003",
             "StationProblemIndicator signals a problem".into(),
         )
     });
     let reserved = ds.reserved() != 0;
-    cond(3, reserved, s.reserved, &|| {
+    cond(2, reserved, s.reserved, &|| {
         (
             "PN-RT-DS-004",
             format!("reserved DataStatus bits {:#04x} set", ds.reserved()),
         )
     });
     let transfer = apdu.transfer_status != 0;
-    cond(4, transfer, s.transfer, &|| {
+    cond(3, transfer, s.transfer, &|| {
         (
             "PN-RT-TS-001",
             format!("TransferStatus {:#04x}", apdu.transfer_status),
@@ -1738,7 +1795,7 @@ fn stream_frame(
         .as_ref()
         .is_some_and(|info| data.len() < info.data_length);
     let announced = s.info.as_ref().map_or(0, |i| i.data_length);
-    cond(5, short, s.short, &|| {
+    cond(4, short, s.short, &|| {
         (
             "PN-RT-LEN-001",
             format!(
@@ -1747,6 +1804,14 @@ fn stream_frame(
             ),
         )
     });
+    if stop && !s.stop && s.run_seen {
+        s.stop_pending = Some((*at, ev()));
+    }
+    if !stop {
+        if let Some((start, evidence)) = s.stop_pending.take() {
+            stop_after_run(rec, &s.label, start, evidence, Some(*at));
+        }
+    }
     if stop && !s.stop && !s.run_seen {
         s.stop_allowed = rec.allowed(
             "PN-RT-DS-002",

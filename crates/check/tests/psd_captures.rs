@@ -22,6 +22,18 @@ fn run(spec: &Spec, bytes: &[u8], options: PnOptions) -> Report {
     check(spec, options, events).unwrap()
 }
 
+/// A classic pcap file without its last `n` records.
+fn without_last(pcap: &[u8], n: usize) -> Vec<u8> {
+    let mut starts = Vec::new();
+    let mut at = 24;
+    while at + 16 <= pcap.len() {
+        starts.push(at);
+        let len = u32::from_le_bytes(pcap[at + 8..at + 12].try_into().unwrap()) as usize;
+        at += 16 + len;
+    }
+    pcap[..starts[starts.len() - n]].to_vec()
+}
+
 fn counts(r: &Report) -> BTreeMap<String, u64> {
     r.counts()
         .into_iter()
@@ -178,6 +190,35 @@ fn a_missing_required_drive_fails() {
         require: vec!["psd4xx".into()],
     });
     assert_eq!(r.verdict, Verdict::Fail);
+}
+
+/// A controller that goes to STOP and then releases the AR (shutting down) violates nothing:
+/// the STOP from RUN to the Release is listed as an allowed state with its end at the
+/// Release; the same STOP without the Release stays a `should` finding.
+#[test]
+fn a_controller_in_stop_until_its_release_is_no_violation() {
+    let spec = Spec::builtin().unwrap();
+    let scenario = PsdScenario {
+        stop_before_release: true,
+        ..PsdScenario::default()
+    };
+    let bytes = psd_capture(&spec, &scenario).unwrap();
+    let r = run(&spec, &bytes, PnOptions::default());
+    assert_eq!(r.drives.len(), 1, "{:?}", r.notes);
+    assert_eq!(counts(&r), BTreeMap::new(), "{:#?}", r.violations);
+    assert_eq!(r.verdict, Verdict::Pass);
+    let shutdown = r
+        .allowed
+        .iter()
+        .find(|a| a.requirement == "PN-RT-DS-002")
+        .unwrap();
+    assert!(shutdown.message.contains("Release"), "{shutdown:?}");
+    assert!(shutdown.end.unwrap().frame > shutdown.start.frame);
+    // Without the Release (its request and answer: the last two records) the STOP is still
+    // a finding.
+    let r = run(&spec, &without_last(&bytes, 2), PnOptions::default());
+    let want: BTreeMap<String, u64> = [("PN-RT-DS-002".to_owned(), 1)].into();
+    assert_eq!(counts(&r), want, "{:#?}", r.violations);
 }
 
 /// A controller in STOP from its first frame (start-up) and one that goes to STOP during a

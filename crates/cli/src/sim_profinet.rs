@@ -66,9 +66,12 @@ pub fn run(spec: &Spec, sim: &ProfinetSim<'_>) -> Result<Outcome> {
         ..OpenOptions::default()
     };
     let mut sock = RawSocket::open(sim.iface, options)?;
-    // A bound PNIO-CM port keeps the kernel from answering the calls the device serves on
-    // the interface's own address with ICMP "port unreachable"; nothing reads it.
+    // Bound PNIO-CM ports keep the kernel from answering with ICMP "port unreachable" the
+    // calls the device serves on the interface's own address and the answers to the calls it
+    // makes itself (ApplicationReady); nothing reads them.
     let _quiet = drivespec_wire::bind_udp(sim.iface, drivespec_capture::dcerpc::PNIO_PORT).ok();
+    let _quiet_client =
+        drivespec_wire::bind_udp(sim.iface, drivespec_profinet::device::CLIENT_PORT).ok();
     let interrupt = Interrupt::install(sim.time_limit)?;
     let mut device = Device::new(spec, config)?;
     let stderr = std::io::stderr();

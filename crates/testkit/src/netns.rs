@@ -140,6 +140,43 @@ impl NsChild {
         until(err, marker, "stderr")
     }
 
+    /// Reads stderr (started with [`NsChild::spawn_piped`]) until `done` holds for a piece
+    /// of it, and returns that piece; pieces end at a newline or a carriage return (the
+    /// progress counts of `dumpcap`). Panics when stderr ends first.
+    pub fn wait_err_piece(&mut self, mut done: impl FnMut(&str) -> bool) -> String {
+        let err = self.stderr.as_mut().expect("stderr is piped");
+        let mut piece = Vec::new();
+        loop {
+            let mut byte = [0u8; 1];
+            let n = err.read(&mut byte).expect("read stderr");
+            assert!(
+                n > 0,
+                "the process ended before the awaited output on stderr"
+            );
+            if byte[0] == b'\n' || byte[0] == b'\r' {
+                let text = String::from_utf8_lossy(&piece).into_owned();
+                if done(&text) {
+                    return text;
+                }
+                piece.clear();
+            } else {
+                piece.push(byte[0]);
+            }
+        }
+    }
+
+    /// Sends SIGINT (`kill -INT`), so that the process ends the way Ctrl-C ends it (a
+    /// recorder flushes its file), and waits for it to end.
+    pub fn interrupt(self) -> Ended {
+        let pid = self.child.id().to_string();
+        let sent = Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .expect("run kill");
+        assert!(sent.success(), "kill -INT {pid}");
+        self.finish()
+    }
+
     /// Waits for the process to end.
     pub fn finish(mut self) -> Ended {
         let mut out = String::new();

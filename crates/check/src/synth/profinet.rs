@@ -383,6 +383,9 @@ pub struct PsdScenario {
     /// The controller goes to STOP for 50 cycles during the first positioning run (provider
     /// STOP, IOPS bad, outputs 0); the drive keeps the last valid outputs (3.9).
     pub stop_during_run: bool,
+    /// The controller goes to STOP for the last 20 cycles and then releases the AR (a
+    /// controller shutting down).
+    pub stop_before_release: bool,
 }
 
 impl Default for PsdScenario {
@@ -394,6 +397,7 @@ impl Default for PsdScenario {
             idle_start: 0,
             startup_stop: 0,
             stop_during_run: false,
+            stop_before_release: false,
         }
     }
 }
@@ -618,7 +622,10 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
             let stopped = cycle <= u64::from(scenario.startup_stop)
                 || (scenario.stop_during_run
                     && matches!(step, Step::Run(_))
-                    && (10..60).contains(&step_cycles));
+                    && (10..60).contains(&step_cycles))
+                || (scenario.stop_before_release
+                    && matches!(step, Step::Idle(100))
+                    && step_cycles > 80);
             // With the controller in STOP the drive keeps the last valid outputs (3.9).
             if !stopped {
                 last_valid.clone_from(&out_bytes);
@@ -725,6 +732,11 @@ pub fn psd_capture(spec: &Spec, scenario: &PsdScenario) -> Result<Vec<u8>, Synth
             }
             w.now += CYCLE_US;
         }
+    }
+    if scenario.stop_before_release {
+        // Release (IEC 61158-6-10 ReleaseBlockReq 0x0114, ControlCommand Release) and its
+        // answer (Done).
+        w.rpc_pair(1, &control_block(0x0114, 4), &control_block(0x8114, 8))?;
     }
     w.pcap.into_inner().map_err(SynthError::io)
 }
