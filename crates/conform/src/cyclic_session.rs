@@ -497,6 +497,50 @@ impl Finding {
     }
 }
 
+/// Cycles whose sample a comparison of changes passes over, per side (by cycle index).
+#[derive(Clone, Copy)]
+struct Held<'h> {
+    device: &'h dyn Fn(usize) -> bool,
+    reference: &'h dyn Fn(usize) -> bool,
+}
+
+impl Held<'static> {
+    const NONE: Held<'static> = Held {
+        device: &|_| false,
+        reference: &|_| false,
+    };
+}
+
+/// Samples of a stop where a run reverses (the reference loop, 4.2.1): a drive may stand
+/// for a moment there and show it in the running bit. The cycles that show `running` clear
+/// with at most [`REVERSAL_SAMPLES`] samples to the nearest moving samples before and after,
+/// which move in opposite directions; `motion` gives (speed, status) of a cycle's sample.
+fn reversal_stops(
+    len: usize,
+    running: u16,
+    motion: impl Fn(usize) -> Option<(i64, u16)>,
+) -> Vec<bool> {
+    let moving = |i: usize| {
+        motion(i)
+            .filter(|(v, st)| st & running != 0 && *v != 0)
+            .map(|(v, _)| v.signum())
+    };
+    (0..len)
+        .map(|j| {
+            if motion(j).is_none_or(|(_, st)| st & running != 0) {
+                return false;
+            }
+            let before = (1..=REVERSAL_SAMPLES).find_map(|k| j.checked_sub(k).and_then(moving));
+            let after = (1..=REVERSAL_SAMPLES).find_map(|k| moving(j + k));
+            matches!((before, after), (Some(a), Some(b)) if a == -b)
+        })
+        .collect()
+}
+
+/// Longest stop, in samples, at a reversal that [`reversal_stops`] passes over. A choice:
+/// at the 10 ms cycle of the suites, two samples are a stop of up to 30 ms.
+const REVERSAL_SAMPLES: usize = 2;
+
 /// Where the changes of one observed quantity differ between the device and the reference.
 struct Divergence<T> {
     /// The cycle where it shows.
@@ -522,13 +566,19 @@ fn first_difference<I, T: PartialEq + Clone>(
     value: impl Fn(&I) -> T,
     skip: impl Fn(&T) -> bool,
     lead: Option<T>,
+    held: Held<'_>,
 ) -> Option<Divergence<T>> {
-    let changes = |start: Option<T>, side: &mut dyn Iterator<Item = (usize, usize, &I)>| {
+    let changes = |start: Option<T>,
+                   side: &mut dyn Iterator<Item = (usize, usize, &I)>,
+                   held: &dyn Fn(usize) -> bool| {
         let mut out: Vec<(usize, usize, T)> = Vec::new();
         if let Some(v) = start.filter(|v| !skip(v)) {
             out.push((from, 0, v));
         }
         for (i, step, x) in side {
+            if held(from + i) {
+                continue;
+            }
             let v = value(x);
             if !skip(&v) && out.last().is_none_or(|(_, _, last)| *last != v) {
                 out.push((from + i, step, v));
@@ -563,6 +613,7 @@ fn first_difference<I, T: PartialEq + Clone>(
             .iter()
             .enumerate()
             .filter_map(|(i, c)| c.dut.as_ref().ok().map(|d| (i, c.step, d))),
+        held.device,
     );
     let r = changes(
         r_start,
@@ -570,6 +621,7 @@ fn first_difference<I, T: PartialEq + Clone>(
             .iter()
             .enumerate()
             .map(|(i, c)| (i, c.step, &c.reference)),
+        held.reference,
     );
     // The step of the stimulus of a reference's change: that of the cycle before it at the
     // latest (the reference shows a reaction in the cycle after the output that caused it).
@@ -1129,6 +1181,25 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 speed != 0 || status & running != 0
             });
         let end = run.cycles.len();
+        let motion = |c: &Cycle<F::Input>, dut: bool| {
+            let i = if dut {
+                c.dut.as_ref().ok()?
+            } else {
+                &c.reference
+            };
+            let (_, speed, status) = F::motion(i);
+            Some((speed, status))
+        };
+        let stops = [true, false].map(|dut| {
+            reversal_stops(end, running, |i| {
+                run.cycles.get(i).and_then(|c| motion(c, dut))
+            })
+        });
+        let [device_stop, reference_stop] = [0, 1].map(|k| {
+            let v = stops.get(k);
+            move |i: usize| v.and_then(|v| v.get(i)).copied().unwrap_or(false)
+        });
+        let none = |_: usize| false;
         for w in bounds.windows(2) {
             let (from, to) = match w {
                 [a, b] if a < b => (*a, *b),
@@ -1161,6 +1232,17 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     |i| F::motion(i).2 & mask != 0,
                     |_| false,
                     (mask == running).then_some(true),
+                    if mask == running {
+                        Held {
+                            device: &device_stop,
+                            reference: &reference_stop,
+                        }
+                    } else {
+                        Held {
+                            device: &none,
+                            reference: &none,
+                        }
+                    },
                 )
                 .filter(|x| !late(x.device.is_none(), x.theirs))
                 {
@@ -1192,6 +1274,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 |i| F::motion(i).1.signum(),
                 |v| *v == 0,
                 None,
+                Held::NONE,
             )
             .filter(|x| !(movement_open || late(x.device.is_none(), x.theirs)))
             {
@@ -1209,7 +1292,15 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     ),
                 ));
             }
-            if let Some(x) = first_difference(before, segment, from, F::channel, |_| false, None) {
+            if let Some(x) = first_difference(
+                before,
+                segment,
+                from,
+                F::channel,
+                |_| false,
+                None,
+                Held::NONE,
+            ) {
                 bad.push(Finding::at(
                     x.at,
                     run.cycles.get(x.at).map_or(0, |c| c.step),
