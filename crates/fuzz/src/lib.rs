@@ -778,9 +778,20 @@ pub fn minimize_on(
     r: &Replay,
     link: Box<dyn Link>,
 ) -> Result<Option<Replay>, FuzzError> {
+    minimize_on_device(spec, opts, r, Device::Link(link))
+}
+
+/// [`minimize`] on a device of the caller's (a link, a cyclic-exchange peer, a PROFINET
+/// wire).
+pub fn minimize_on_device(
+    spec: &Spec,
+    opts: &Options,
+    r: &Replay,
+    device: Device,
+) -> Result<Option<Replay>, FuzzError> {
     check_family(opts, r)?;
     let settings = replay_settings(opts, r);
-    with_target(spec, opts, &settings, Some(Device::Link(link)), |t| {
+    with_target(spec, opts, &settings, Some(device), |t| {
         Ok(minimize_with(t, opts, &settings, r))
     })
 }

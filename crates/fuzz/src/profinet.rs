@@ -56,9 +56,13 @@ impl<'s> ProfinetTarget<'s> {
         }
     }
 
-    /// The probe alone, from the current state: None when the device passes it, else why
-    /// not (a setup error before fuzzing: no station).
+    /// The probe alone, after the device restarted (a simulated one) or answered Identify
+    /// again (a device that may be restarting): None when it passes, else why not (a setup
+    /// error before fuzzing: no station).
     pub(crate) fn check_alive(&mut self) -> Option<String> {
+        if let Err(e) = self.runner.fresh() {
+            return Some(e.to_string());
+        }
         match self.runner.probe() {
             Ok(Ok(_)) => None,
             Ok(Err((stage, why))) => Some(format!("{}: {why}", stage.as_str())),

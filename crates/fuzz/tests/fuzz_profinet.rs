@@ -100,6 +100,10 @@ fn a_planted_fault_is_found_minimised_and_replayed() {
         f.replay.finding.as_ref().unwrap().signature,
         "hang/profinet-probe/dcp-identify"
     );
+    println!(
+        "seed 0: found in sequence {}",
+        f.replay.finding.as_ref().unwrap().sequence
+    );
     // Minimised to the one malformed Identify.
     assert_eq!(f.replay.steps.len(), 1, "{}", f.replay.to_json());
     let Action::Profinet(PnStep::DcpIdentify { blocks }) = &f.replay.steps[0].action else {

@@ -129,12 +129,4 @@ impl PnStep {
             other => other.clone(),
         }
     }
-
-    /// Whether the step runs in an AR of the fuzzer's.
-    pub fn needs_ar(&self) -> bool {
-        matches!(
-            self,
-            PnStep::RecordRead { .. } | PnStep::RecordWrite { .. } | PnStep::Rt { .. }
-        )
-    }
 }
