@@ -60,7 +60,7 @@ impl<'s> ProfinetTarget<'s> {
     /// again (a device that may be restarting): None when it passes, else why not (a setup
     /// error before fuzzing: no station).
     pub(crate) fn check_alive(&mut self) -> Option<String> {
-        if let Err(e) = self.runner.fresh() {
+        if let Err(e) = self.runner.fresh_within(exec::SETUP_WAIT) {
             return Some(e.to_string());
         }
         match self.runner.probe() {

@@ -76,6 +76,10 @@ const PROBE_FRAMES: u64 = 8;
 /// Longest wait for a device to answer Identify again before a run (a device that
 /// restarted); a choice: small devices restart within seconds.
 const RECOVER: Duration = Duration::from_secs(15);
+/// Longest wait for a device to answer Identify before the first probe of a run or replay
+/// (a device still restarting from a finding a moment ago); a choice, short so that a name
+/// nobody answers to is reported within seconds.
+pub(crate) const SETUP_WAIT: Duration = Duration::from_secs(3);
 /// Longest frame sent: 1,500 payload bytes and the Ethernet header (a controller asked for
 /// longer module data than a frame holds sends nothing instead).
 const MAX_FRAME: usize = 1514;
@@ -147,8 +151,13 @@ impl<'w> Runner<'w> {
     }
 
     /// Back to the start: the device restarted where the wire can (true), else waited for
-    /// until it answers Identify again.
+    /// until it answers Identify again (at most [`RECOVER`]).
     pub(crate) fn fresh(&mut self) -> Result<bool, PnWireError> {
+        self.fresh_within(RECOVER)
+    }
+
+    /// [`Runner::fresh`], waiting at most `wait` for a device that cannot be restarted.
+    pub(crate) fn fresh_within(&mut self, wait: Duration) -> Result<bool, PnWireError> {
         self.session = None;
         if self.wire.can_restart() {
             self.wire.restart();
@@ -157,7 +166,7 @@ impl<'w> Runner<'w> {
             self.device = None;
             return Ok(true);
         }
-        let until = self.wire.now() + RECOVER;
+        let until = self.wire.now() + wait;
         while self.wire.now() < until {
             if self.locate()?.is_some() {
                 break;
