@@ -155,3 +155,70 @@ fn a_replay_of_another_layer_is_refused() {
     assert!(Replay::from_json(&text, "x").is_err());
     let _ = std::fs::remove_dir_all(out);
 }
+
+/// The reference device with the frames it sends that `drop` picks lost on the wire.
+struct Lossy {
+    device: drivespec_profinet::Device,
+    drop: fn(&[u8]) -> bool,
+}
+
+impl drivespec_profinet::SansIo for Lossy {
+    fn handle_frame(&mut self, now: std::time::Duration, frame: &[u8]) {
+        self.device.handle_frame(now, frame);
+    }
+    fn handle_timeout(&mut self, now: std::time::Duration) {
+        self.device.handle_timeout(now);
+    }
+    fn poll_transmit(&mut self, now: std::time::Duration) -> Option<Vec<u8>> {
+        loop {
+            let f = self.device.poll_transmit(now)?;
+            if !(self.drop)(&f) {
+                return Some(f);
+            }
+        }
+    }
+    fn poll_timeout(&self) -> Option<std::time::Duration> {
+        self.device.poll_timeout()
+    }
+}
+
+fn lossy(drop: fn(&[u8]) -> bool) -> Device {
+    let device = reference(spec(), "PSD426", DEVICE.0, DEVICE.1, STATION);
+    Device::Profinet(Box::new(MemoryWire::new(
+        Box::new(move || Lossy {
+            device: device.clone(),
+            drop,
+        }),
+        FUZZER,
+        STATION,
+        "lossy PSD426 in memory",
+    )))
+}
+
+#[test]
+fn the_probe_names_the_stage_a_device_fails() {
+    let out = dir("stages");
+    let run = |d: Device| match fuzz::run_on_device(
+        spec(),
+        &opts(out.clone(), 1),
+        d,
+        &mut std::io::sink(),
+    ) {
+        Ok(_) => panic!("a device that fails the probe is a setup error"),
+        Err(e) => e.to_string(),
+    };
+    // No cyclic frame (RT class 1 FrameIDs 0xC000–0xF7FF) reaches the fuzzer.
+    let e = run(lossy(|f| {
+        f.get(12..14) == Some(&[0x88, 0x92])
+            && f.get(14..16)
+                .is_some_and(|id| (0xC000..0xF800).contains(&u16::from_be_bytes([id[0], id[1]])))
+    }));
+    assert!(e.contains("cyclic-data"), "{e}");
+    // No IPv4 frame (the PNIO-CM answers) reaches the fuzzer.
+    let e = run(lossy(|f| f.get(12..14) == Some(&[0x08, 0x00])));
+    assert!(e.contains("connect"), "{e}");
+    // Nothing at all.
+    let e = run(lossy(|_| true));
+    assert!(e.contains("dcp-identify") && e.contains(STATION), "{e}");
+    let _ = std::fs::remove_dir_all(out);
+}
