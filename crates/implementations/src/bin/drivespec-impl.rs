@@ -24,6 +24,13 @@ fn main() -> ExitCode {
         let name = args
             .get(3)
             .map_or(profinet_faults::NAMES[0], String::as_str);
+        if !profinet_faults::NAMES.contains(&name) {
+            eprintln!(
+                "drivespec-impl: no PROFINET fault named {name:?}; known: {}",
+                profinet_faults::NAMES.join(", ")
+            );
+            return ExitCode::from(2);
+        }
         return match profinet_faults::serve_profinet(iface, station, name, TIME_LIMIT) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
