@@ -17,6 +17,7 @@ pub mod check;
 pub mod hpd;
 mod ops;
 pub mod pd;
+pub mod profinet;
 pub mod psd4xx;
 pub mod psx3xx;
 pub mod script;
@@ -53,4 +54,5 @@ pub const TARGETS: &[Target] = &[
     ("script_psx3xx", script::psx3xx),
     ("select_pattern", select::pattern),
     ("select_expectations", select::expectations),
+    ("profinet_device", profinet::device),
 ];

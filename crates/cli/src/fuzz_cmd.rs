@@ -8,7 +8,7 @@ use drivespec_conform::dut::Dut;
 use drivespec_conform::select::{closest, did_you_mean};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::Progress;
-use drivespec_fuzz::{self as fuzz, Options, Replay, ReplayOutcome};
+use drivespec_fuzz::{self as fuzz, Device, Layer, Options, Replay, ReplayOutcome};
 use drivespec_spec::FamilyId;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -21,9 +21,15 @@ const SUMMARY_SCHEMA: &str = "drivespec-fuzz-summary/1";
 pub struct FuzzArgs {
     /// Family: hpd, psd4xx or psx3xx.
     family: String,
-    /// Device under test: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS'.
+    /// Device under test: sim[:MODEL], serial:PATH?baud=N, tcp:HOST:PORT, exec:'COMMAND ARGS',
+    /// profinet:IFACE/NAME (with --layer profinet).
     #[arg(long, default_value = "sim")]
     dut: String,
+    /// Layer the inputs act at: application (the family's own messages) or profinet (DCP,
+    /// Connect, records and RT frames to a PSD4xx IO device, each sequence followed by a
+    /// liveness probe). A replay file's own layer is the default for --replay and --minimize.
+    #[arg(long, value_name = "LAYER", value_parser = ["application", "profinet"])]
+    layer: Option<String>,
     /// Device model.
     #[arg(long)]
     model: Option<String>,
@@ -76,9 +82,18 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
         )
     };
     let dut: Dut = args.dut.parse()?;
+    let file = args.replay.as_ref().or(args.minimize.as_ref());
+    let replay = file.map(|f| Replay::load(f)).transpose()?;
+    let layer = match (args.layer.as_deref(), &replay) {
+        (Some("profinet"), _) => Layer::Profinet,
+        (Some(_), _) => Layer::Application,
+        (None, Some(r)) => r.layer,
+        (None, None) => Layer::Application,
+    };
     let interrupt = Interrupt::install(args.timeout)?;
     let opts = Options {
         family,
+        layer,
         dut,
         settings: Settings {
             address: args.address,
@@ -103,9 +118,20 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
         stop: interrupt.flag(),
     };
     let spec = ctx.spec()?;
-    if let Some(file) = &args.replay {
-        let r = Replay::load(file)?;
-        let out = fuzz::replay(&spec, &opts, &r)?;
+    // The socket loop of a PROFINET device under test is this side's.
+    let wire = || -> Result<Option<Device>> {
+        match (&opts.layer, &opts.dut) {
+            (Layer::Profinet, Dut::Profinet { iface, name }) => Ok(Some(Device::Profinet(
+                Box::new(crate::fuzz_profinet::RawWire::open(iface, name)?),
+            ))),
+            _ => Ok(None),
+        }
+    };
+    if let (Some(file), Some(r)) = (&args.replay, &replay) {
+        let out = match wire()? {
+            Some(d) => fuzz::replay_on_device(&spec, &opts, r, d)?,
+            None => fuzz::replay(&spec, &opts, r)?,
+        };
         print_replay(ctx, file, &out)?;
         return Ok(if out.exit_code() == 0 {
             Outcome::Pass
@@ -113,12 +139,14 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
             Outcome::Fail
         });
     }
-    if let Some(file) = &args.minimize {
-        let r = Replay::load(file)?;
-        return minimize(ctx, &opts, &spec, file, &r);
+    if let (Some(file), Some(r)) = (&args.minimize, &replay) {
+        return minimize(ctx, &opts, &spec, file, r, wire()?);
     }
     let mut err = std::io::stderr();
-    let summary = fuzz::run(&spec, &opts, &mut err)?;
+    let summary = match wire()? {
+        Some(d) => fuzz::run_on_device(&spec, &opts, d, &mut err)?,
+        None => fuzz::run(&spec, &opts, &mut err)?,
+    };
     let s = &summary.stats;
     match ctx.format {
         Format::Json => say!(
@@ -179,8 +207,13 @@ fn minimize(
     spec: &drivespec_spec::Spec,
     file: &Path,
     r: &Replay,
+    device: Option<Device>,
 ) -> Result<Outcome> {
-    let Some(min) = fuzz::minimize(spec, opts, r)? else {
+    let min = match device {
+        Some(d) => fuzz::minimize_on_device(spec, opts, r, d)?,
+        None => fuzz::minimize(spec, opts, r)?,
+    };
+    let Some(min) = min else {
         match ctx.format {
             Format::Json => say!("{}", json(&serde_json::json!({ "fails": false })))?,
             Format::Text => say!(

@@ -23,6 +23,7 @@ mod check_cmd;
 mod completions_cmd;
 mod conform_cmd;
 mod fuzz_cmd;
+mod fuzz_profinet;
 mod hpd_cmd;
 mod input;
 mod interrupt;

@@ -141,6 +141,7 @@ impl<'a, 's> HpdTarget<'a, 's> {
             )) => "listen".to_owned(),
             Some(Action::Hpd(h)) => h.name().to_owned(),
             Some(Action::Psd4xx(_) | Action::Psx3xx(_)) => "cyclic".to_owned(),
+            Some(Action::Profinet(_)) => "profinet".to_owned(),
             None => "start".to_owned(),
         }
     }

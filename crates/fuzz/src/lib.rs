@@ -26,6 +26,7 @@ mod ddmin;
 mod engine;
 mod hpd;
 mod output;
+pub mod profinet;
 mod psd4xx;
 mod psx3xx;
 mod replay;
@@ -33,7 +34,8 @@ mod stats;
 
 pub use output::{json as report_json, Finding};
 pub use replay::{
-    Action, FindingClass, FindingInfo, Observed, Replay, ReplayError, Start, Step, REPLAY_FORMAT,
+    Action, FindingClass, FindingInfo, Layer, Observed, Replay, ReplayError, Start, Step,
+    REPLAY_FORMAT,
 };
 pub use stats::{FindingSummary, Stats, STATS_SCHEMA};
 
@@ -62,6 +64,8 @@ pub const DEFAULT_ITERATIONS: u64 = 1000;
 pub struct Options {
     /// The family (HPD, PSD4xx or PSx3xx).
     pub family: FamilyId,
+    /// The layer the inputs act at (`--layer`; `profinet` for a PSD4xx on the network).
+    pub layer: Layer,
     /// The device under test.
     pub dut: Dut,
     /// Address, seed, model, slack, bit rate.
@@ -91,6 +95,7 @@ impl Default for Options {
     fn default() -> Options {
         Options {
             family: FamilyId::Hpd,
+            layer: Layer::Application,
             dut: Dut::default(),
             settings: Settings::default(),
             iterations: None,
@@ -198,6 +203,9 @@ pub enum Device {
     /// A cyclic-exchange peer (PSD4xx, PSx3xx): e.g. a [`drivespec_conform::cyclic::LocalPeer`] on a test
     /// device.
     Peer(Box<dyn Peer>),
+    /// A PSD4xx PROFINET IO device on a wire (`--layer profinet`): a raw socket loop of the
+    /// caller's, or a [`profinet::MemoryWire`].
+    Profinet(Box<dyn profinet::PnWire>),
 }
 
 /// How long a device on a link may take for one cyclic reply (a process may take a while to
@@ -212,12 +220,20 @@ fn with_target<R>(
     device: Option<Device>,
     f: impl FnOnce(&mut dyn Target) -> Result<R, FuzzError>,
 ) -> Result<R, FuzzError> {
+    if opts.layer == Layer::Profinet {
+        return with_profinet_target(spec, opts, settings, device, f);
+    }
+    if let Some(Device::Profinet(_)) = device {
+        return Err(FuzzError::Setup(SetupError::Usage(
+            "a PROFINET wire needs --layer profinet".to_owned(),
+        )));
+    }
     match opts.family {
         FamilyId::Hpd => {
             let suite = HpdSuite::new(spec, settings)?;
             let link = match device {
                 Some(Device::Link(l)) => l,
-                Some(Device::Peer(_)) => {
+                Some(Device::Peer(_) | Device::Profinet(_)) => {
                     return Err(FuzzError::Setup(SetupError::Usage(
                         "hpd needs a byte link, not a cyclic-exchange peer".to_owned(),
                     )))
@@ -232,7 +248,7 @@ fn with_target<R>(
             let peer: Box<dyn Peer> = match device {
                 Some(Device::Peer(p)) => p,
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
-                None => suite.peer(&opts.dut)?,
+                Some(Device::Profinet(_)) | None => suite.peer(&opts.dut)?,
             };
             let mut target = crate::psd4xx::target(&suite, peer)?;
             f(&mut target)
@@ -242,12 +258,77 @@ fn with_target<R>(
             let peer: Box<dyn Peer + '_> = match device {
                 Some(Device::Peer(p)) => p,
                 Some(Device::Link(l)) => Box::new(LinkPeer::new(l, CYCLIC_TIMEOUT_US)),
-                None => suite.peer(&opts.dut)?,
+                Some(Device::Profinet(_)) | None => suite.peer(&opts.dut)?,
             };
             let mut target = crate::psx3xx::target(&suite, peer)?;
             f(&mut target)
         }
     }
+}
+
+/// NameOfStation of the simulated device of `--layer profinet --dut sim`.
+const SIM_STATION: &str = "psd4xx-sim";
+/// MAC and IP of the simulated device and of the fuzzer on its virtual wire
+/// (locally administered addresses, a private subnet).
+const SIM_DEVICE: ([u8; 6], [u8; 4]) = ([0x02, 0x00, 0x00, 0x00, 0x04, 0x01], [10, 4, 0, 2]);
+/// The fuzzer's side of the virtual wire.
+const SIM_CONTROLLER: ([u8; 6], [u8; 4]) = ([0x02, 0x00, 0x00, 0x00, 0x04, 0x02], [10, 4, 0, 1]);
+
+/// The PROFINET-layer target on `device` (a wire of the caller's) or, for `--dut sim`, on
+/// the reference device in memory; the device must pass the liveness probe first (else
+/// a setup error: no such station, Connect refused).
+fn with_profinet_target<R>(
+    spec: &Spec,
+    opts: &Options,
+    settings: &Settings,
+    device: Option<Device>,
+    f: impl FnOnce(&mut dyn Target) -> Result<R, FuzzError>,
+) -> Result<R, FuzzError> {
+    if opts.family != FamilyId::Psd4xx {
+        return Err(FuzzError::Setup(SetupError::Usage(format!(
+            "--layer profinet is for psd4xx, not {}",
+            opts.family
+        ))));
+    }
+    let setup = |e: String| FuzzError::Setup(SetupError::Spec(e));
+    let identity =
+        drivespec_profinet::Identity::from_spec(spec).map_err(|e| setup(e.to_string()))?;
+    let wire: Box<dyn profinet::PnWire> = match (device, &opts.dut) {
+        (Some(Device::Profinet(w)), _) => w,
+        (None, Dut::Sim { .. }) => {
+            let model = settings
+                .model
+                .clone()
+                .unwrap_or_else(|| drivespec_sim::reference::PSD4XX_DEFAULT_MODEL.to_owned());
+            let mut config =
+                drivespec_profinet::DeviceConfig::new(spec, &model, SIM_DEVICE.0, SIM_STATION)
+                    .map_err(|e| setup(e.to_string()))?;
+            config.ip = SIM_DEVICE.1;
+            config.netmask = [255, 255, 255, 0];
+            let fresh =
+                drivespec_profinet::Device::new(spec, config).map_err(|e| setup(e.to_string()))?;
+            Box::new(profinet::MemoryWire::new(
+                Box::new(move || fresh.clone()),
+                SIM_CONTROLLER,
+                SIM_STATION,
+                &format!("sim:{model} (PROFINET IO device in memory)"),
+            ))
+        }
+        _ => {
+            return Err(FuzzError::Setup(SetupError::Usage(format!(
+                "--layer profinet needs --dut sim or a PROFINET wire, not {}",
+                opts.dut
+            ))))
+        }
+    };
+    let what = wire.describe();
+    let mut target = profinet::ProfinetTarget::new(spec, wire, identity);
+    if let Some(why) = target.check_alive() {
+        return Err(FuzzError::Setup(SetupError::Link(
+            drivespec_conform::link::LinkError::Open { what, reason: why },
+        )));
+    }
+    f(&mut target)
 }
 
 /// Runs a fuzzing campaign against `opts.dut` and writes the reports.
@@ -284,10 +365,17 @@ pub fn run_on_device(
 }
 
 /// The replay of a finding, as saved.
-fn replay_of(found: &Found, family: FamilyId, dut: &str, settings: &Settings) -> Replay {
+fn replay_of(
+    found: &Found,
+    family: FamilyId,
+    layer: Layer,
+    dut: &str,
+    settings: &Settings,
+) -> Replay {
     let t0 = found.trial.run.evidence.first().map_or(0, |r| r.at_us);
     Replay {
         family,
+        layer,
         dut: dut.to_owned(),
         address: settings.address,
         model: settings.model.clone(),
@@ -323,8 +411,12 @@ fn replay_of(found: &Found, family: FamilyId, dut: &str, settings: &Settings) ->
 }
 
 fn replay_line(opts: &Options, file: &Path) -> String {
+    let layer = match opts.layer {
+        Layer::Application => String::new(),
+        l => format!(" --layer {l}"),
+    };
     format!(
-        "{} {} --dut {} --replay {}",
+        "{} {}{layer} --dut {} --replay {}",
         opts.command,
         opts.family,
         shell_quote(&opts.dut.to_string()),
@@ -398,7 +490,7 @@ fn campaign(
             },
             Event::Finding(f) => {
                 let id = format!("{family}/fuzz/finding-{}", findings.len() + 1);
-                let replay = replay_of(f, family, &dut, settings);
+                let replay = replay_of(f, family, opts.layer, &dut, settings);
                 let mut finding = Finding::new(id.clone(), f, replay);
                 if !opts.no_reports {
                     let path = opts
@@ -438,7 +530,7 @@ fn campaign(
                 let Some(old) = findings.get_mut(i) else {
                     return;
                 };
-                let replay = replay_of(f, family, &dut, settings);
+                let replay = replay_of(f, family, opts.layer, &dut, settings);
                 let mut finding = Finding::new(old.id.clone(), f, replay);
                 if let Some(path) = old.file.take() {
                     match finding.replay.save(&path) {
@@ -569,6 +661,12 @@ fn check_family(opts: &Options, r: &Replay) -> Result<(), FuzzError> {
             found: r.family,
         });
     }
+    if r.layer != opts.layer {
+        return Err(FuzzError::Setup(SetupError::Usage(format!(
+            "the replay is at layer {}, the run at layer {} (--layer {})",
+            r.layer, opts.layer, r.layer
+        ))));
+    }
     Ok(())
 }
 
@@ -657,7 +755,7 @@ fn minimize_with(
         &trial,
         opts.duration.map(|d| std::time::Instant::now() + d),
     );
-    let mut out = replay_of(&found, family, &opts.dut.to_string(), settings);
+    let mut out = replay_of(&found, family, opts.layer, &opts.dut.to_string(), settings);
     if let (Some(new), Some(old)) = (out.finding.as_mut(), r.finding.as_ref()) {
         new.original_steps = old.original_steps.max(new.original_steps);
     }
@@ -680,9 +778,20 @@ pub fn minimize_on(
     r: &Replay,
     link: Box<dyn Link>,
 ) -> Result<Option<Replay>, FuzzError> {
+    minimize_on_device(spec, opts, r, Device::Link(link))
+}
+
+/// [`minimize`] on a device of the caller's (a link, a cyclic-exchange peer, a PROFINET
+/// wire).
+pub fn minimize_on_device(
+    spec: &Spec,
+    opts: &Options,
+    r: &Replay,
+    device: Device,
+) -> Result<Option<Replay>, FuzzError> {
     check_family(opts, r)?;
     let settings = replay_settings(opts, r);
-    with_target(spec, opts, &settings, Some(Device::Link(link)), |t| {
+    with_target(spec, opts, &settings, Some(device), |t| {
         Ok(minimize_with(t, opts, &settings, r))
     })
 }

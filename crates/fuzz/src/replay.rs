@@ -10,6 +10,7 @@
 //! cyclic-exchange protocol does not know or a step without the fields its action needs are
 //! errors naming the step.
 
+use crate::profinet::PnStep;
 use drivespec_conform::case::Record;
 use drivespec_conform::cyclic::Request;
 use drivespec_conform::link::Micros;
@@ -38,6 +39,43 @@ pub enum Action {
     /// A PSx3xx step (pd-out, hold, until, advance, isdu-read, isdu-write, env; PSx3xx
     /// manual 3.1, 3.3).
     Psx3xx(PsxStep),
+    /// A PSD4xx step at the PROFINET layer (dcp-identify, dcp-set, dcp-get, connect,
+    /// record-read, record-write, rt; IEC 61158-6-10).
+    Profinet(PnStep),
+}
+
+/// The layer a sequence's steps act at (README "Replay files", key `layer`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Layer {
+    /// The family's own steps: serial frames, or the cyclic exchange of the drive's images
+    /// and records.
+    #[default]
+    Application,
+    /// PROFINET frames to a PSD4xx IO device: DCP, PNIO-CM, RT (`fuzz psd4xx --layer
+    /// profinet`).
+    Profinet,
+}
+
+impl Layer {
+    /// The name on the command line and in files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Layer::Application => "application",
+            Layer::Profinet => "profinet",
+        }
+    }
+
+    /// Whether this is the default layer (not written to files).
+    fn is_default(&self) -> bool {
+        *self == Layer::Application
+    }
+}
+
+impl std::fmt::Display for Layer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }
 
 impl Action {
@@ -47,6 +85,7 @@ impl Action {
             Action::Hpd(_) => FamilyId::Hpd,
             Action::Psd4xx(_) => FamilyId::Psd4xx,
             Action::Psx3xx(_) => FamilyId::Psx3xx,
+            Action::Profinet(_) => FamilyId::Psd4xx,
         }
     }
 
@@ -56,6 +95,7 @@ impl Action {
             Action::Hpd(h) => h.bytes(),
             Action::Psd4xx(PsdStep::RecordWrite { hex, .. }) => Some(hex),
             Action::Psx3xx(PsxStep::IsduWrite { data, .. }) => Some(data),
+            Action::Profinet(p) => p.bytes(),
             _ => None,
         }
     }
@@ -77,6 +117,7 @@ impl Action {
                 subindex: *subindex,
                 data: new,
             }),
+            Action::Profinet(p) => Action::Profinet(p.with_bytes(new)),
             other => other.clone(),
         }
     }
@@ -87,6 +128,7 @@ impl Action {
             Action::Hpd(h) => h.name(),
             Action::Psd4xx(p) => p.name(),
             Action::Psx3xx(p) => p.name(),
+            Action::Profinet(p) => p.name(),
         }
     }
 
@@ -279,6 +321,8 @@ impl Observed {
 pub struct Replay {
     /// The family.
     pub family: FamilyId,
+    /// The layer the steps act at.
+    pub layer: Layer,
     /// The device under test it was found on (informative).
     pub dut: String,
     /// Device address (HPD Pr27).
@@ -339,6 +383,8 @@ pub enum ReplayError {
 struct ReplayFile<S> {
     format: String,
     family: FamilyId,
+    #[serde(default, skip_serializing_if = "Layer::is_default")]
+    layer: Layer,
     dut: String,
     address: u8,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -385,6 +431,7 @@ enum StepOut<'a> {
     Hpd(StepFile<&'a HpdStep>),
     Psd4xx(StepFile<&'a PsdStep>),
     Psx3xx(StepFile<&'a PsxStep>),
+    Profinet(StepFile<&'a PnStep>),
 }
 
 impl StepOut<'_> {
@@ -393,6 +440,7 @@ impl StepOut<'_> {
             Action::Hpd(h) => StepOut::Hpd(StepFile::of(s, h)),
             Action::Psd4xx(p) => StepOut::Psd4xx(StepFile::of(s, p)),
             Action::Psx3xx(p) => StepOut::Psx3xx(StepFile::of(s, p)),
+            Action::Profinet(p) => StepOut::Profinet(StepFile::of(s, p)),
         }
     }
 }
@@ -410,12 +458,17 @@ fn read_as<S: DeserializeOwned>(
     })
 }
 
-/// `v` read as a step of `family`.
-fn read_in(family: FamilyId, v: &serde_json::Value) -> Result<Step, serde_json::Error> {
-    match family {
-        FamilyId::Hpd => read_as(v, Action::Hpd),
-        FamilyId::Psd4xx => read_as(v, Action::Psd4xx),
-        FamilyId::Psx3xx => read_as(v, Action::Psx3xx),
+/// `v` read as a step of `family` at `layer`.
+fn read_in(
+    family: FamilyId,
+    layer: Layer,
+    v: &serde_json::Value,
+) -> Result<Step, serde_json::Error> {
+    match (family, layer) {
+        (FamilyId::Psd4xx, Layer::Profinet) => read_as(v, Action::Profinet),
+        (FamilyId::Hpd, _) => read_as(v, Action::Hpd),
+        (FamilyId::Psd4xx, _) => read_as(v, Action::Psd4xx),
+        (FamilyId::Psx3xx, _) => read_as(v, Action::Psx3xx),
     }
 }
 
@@ -423,6 +476,7 @@ fn read_in(family: FamilyId, v: &serde_json::Value) -> Result<Step, serde_json::
 /// step that reads as one of another family is [`ReplayError::OtherFamily`].
 fn read_step(
     family: FamilyId,
+    layer: Layer,
     index: usize,
     v: &serde_json::Value,
     file: &str,
@@ -431,11 +485,11 @@ fn read_step(
         file: file.to_owned(),
         why,
     };
-    let mut step = read_in(family, v).map_err(|e| {
+    let mut step = read_in(family, layer, v).map_err(|e| {
         let other = FamilyId::ALL
             .into_iter()
             .filter(|f| *f != family)
-            .find_map(|f| read_in(f, v).ok());
+            .find_map(|f| read_in(f, Layer::Application, v).ok());
         match other {
             Some(s) => ReplayError::OtherFamily {
                 file: file.to_owned(),
@@ -465,6 +519,7 @@ impl Replay {
         let file = ReplayFile {
             format: REPLAY_FORMAT.to_owned(),
             family: self.family,
+            layer: self.layer,
             dut: self.dut.clone(),
             address: self.address,
             model: self.model.clone(),
@@ -497,11 +552,17 @@ impl Replay {
                 f.format
             )));
         }
+        if f.layer == Layer::Profinet && f.family != FamilyId::Psd4xx {
+            return Err(bad(format!(
+                "layer profinet is a psd4xx layer, not {}",
+                f.family
+            )));
+        }
         let steps = f
             .steps
             .iter()
             .enumerate()
-            .map(|(i, v)| read_step(f.family, i, v, file))
+            .map(|(i, v)| read_step(f.family, f.layer, i, v, file))
             .collect::<Result<Vec<Step>, ReplayError>>()?;
         if let Some(fi) = &f.finding {
             if fi.step >= steps.len() {
@@ -514,6 +575,7 @@ impl Replay {
         }
         Ok(Replay {
             family: f.family,
+            layer: f.layer,
             dut: f.dut,
             address: f.address,
             model: f.model,
@@ -558,6 +620,7 @@ mod tests {
     fn sample() -> Replay {
         Replay {
             family: FamilyId::Hpd,
+            layer: Layer::Application,
             dut: "sim".into(),
             address: 0,
             model: None,

@@ -7,6 +7,9 @@
 //! - violation mutants ([`hpd_mutants`], [`psd4xx_mutants`], [`psx3xx_mutants`]): each
 //!   breaks the manual in one planted way, and must fail, naming the requirement it breaks.
 //!
+//! - PROFINET IO devices with a planted fault ([`profinet_faults`]): the PSD4xx on the wire
+//!   deviating in one way, which `drivespec fuzz --layer profinet` must find.
+//!
 //! [`catalogue`] names them all; [`serve`] serves one on stdin/stdout with the protocol of its
 //! family (the HPD serial line, `drivespec-cyclic/1`), which the binary `drivespec-impl`
 //! does, so each runs as an `exec:` device under test too. The conformance tests
@@ -30,6 +33,7 @@ pub mod catalogue;
 pub mod hpd_motion_mutants;
 pub mod hpd_mutants;
 pub mod hpd_variants;
+pub mod profinet_faults;
 pub mod psd4xx_mutants;
 pub mod psd4xx_variants;
 pub mod psx3xx_mutants;

@@ -68,6 +68,8 @@ pub struct ControllerConfig {
     pub reduction_ratio: u16,
     /// DataHoldFactor (cycles without a valid frame before the AR ends).
     pub data_hold_factor: u16,
+    /// C_SDU length asked for in both IOCRs (IEC 61158-6-10 "DataLength": 40 to 1440).
+    pub data_length: u16,
     /// Time to wait for an answer to one RPC call or DCP request before repeating it.
     pub rpc_timeout: Duration,
     /// Repeats of an unanswered call before it fails.
@@ -114,6 +116,7 @@ impl ControllerConfig {
             send_clock_factor: 32,
             reduction_ratio: 1,
             data_hold_factor: 3,
+            data_length: u16::try_from(MIN_C_SDU).unwrap_or(40),
             rpc_timeout: Duration::from_secs(1),
             rpc_retries: 3,
             identify_timeout: Duration::from_secs(3),
@@ -428,6 +431,11 @@ impl Controller {
     /// The latest input data.
     pub fn input(&self) -> Option<&InputData> {
         self.input.as_ref()
+    }
+
+    /// The FrameID the device gave the output CR (0xFFFF before its Connect answer).
+    pub fn output_frame_id(&self) -> FrameId {
+        self.output_frame
     }
 
     /// Input frames received.
@@ -938,7 +946,7 @@ impl Controller {
             reference: if input { 1 } else { 2 },
             lt: ethertype::PROFINET,
             properties: 1,
-            data_length: u16::try_from(MIN_C_SDU).unwrap_or(40),
+            data_length: self.config.data_length,
             frame_id: if input {
                 INPUT_FRAME_ID
             } else {

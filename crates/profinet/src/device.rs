@@ -110,16 +110,6 @@ pub struct DeviceConfig {
     pub hello: bool,
     /// Server boot time in the RPC headers.
     pub server_boot: u32,
-    /// A planted fault, for testing fuzzers and checkers against a wrong device.
-    pub fault: Option<Fault>,
-}
-
-/// A deliberate deviation a device can be built with (our doc: module `device`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum Fault {
-    /// After an Identify request whose blocks do not parse, DCP is never answered again.
-    DcpDeafAfterMalformedIdentify,
 }
 
 impl DeviceConfig {
@@ -143,7 +133,6 @@ impl DeviceConfig {
             drive,
             hello: false,
             server_boot: 1,
-            fault: None,
         })
     }
 }
@@ -266,7 +255,6 @@ pub struct Device {
     cache: VecDeque<((Uuid, u32), Vec<u8>)>,
     ip_id: u16,
     now: Duration,
-    dcp_deaf: bool,
 }
 
 fn push<T>(q: &mut VecDeque<T>, v: T) {
@@ -274,6 +262,21 @@ fn push<T>(q: &mut VecDeque<T>, v: T) {
         q.pop_front();
     }
     q.push_back(v);
+}
+
+impl crate::SansIo for Device {
+    fn handle_frame(&mut self, now: Duration, frame: &[u8]) {
+        Device::handle_frame(self, now, frame);
+    }
+    fn handle_timeout(&mut self, now: Duration) {
+        Device::handle_timeout(self, now);
+    }
+    fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>> {
+        Device::poll_transmit(self, now)
+    }
+    fn poll_timeout(&self) -> Option<Duration> {
+        Device::poll_timeout(self)
+    }
 }
 
 impl Device {
@@ -294,7 +297,6 @@ impl Device {
             cache: VecDeque::new(),
             ip_id: 0,
             now: Duration::ZERO,
-            dcp_deaf: false,
         };
         if d.config.hello {
             d.hello();
@@ -600,14 +602,7 @@ impl Device {
     }
 
     fn dcp(&mut self, src: Mac, class: FrameClass, h: &DcpHeader<'_>) {
-        if h.service_type != service_type::REQUEST || self.dcp_deaf {
-            return;
-        }
-        if self.config.fault == Some(Fault::DcpDeafAfterMalformedIdentify)
-            && class == FrameClass::DcpIdentifyRequest
-            && h.iter_blocks().any(|b| b.is_err())
-        {
-            self.dcp_deaf = true;
+        if h.service_type != service_type::REQUEST {
             return;
         }
         match (class, h.service_id) {

@@ -39,5 +39,20 @@ pub mod udp;
 pub use controller::{
     Controller, ControllerConfig, ControllerError, ControllerEvent, InputData, RecordId,
 };
-pub use device::{ArEnd, Device, DeviceConfig, DeviceError, DeviceEvent, Fault};
+pub use device::{ArEnd, Device, DeviceConfig, DeviceError, DeviceEvent};
+
+use std::time::Duration;
+
+/// A sans-IO station: frames and time in, frames out (module docs above). Lets one socket
+/// loop or virtual wire serve the reference device and any wrapper of it.
+pub trait SansIo {
+    /// A frame received at `now`.
+    fn handle_frame(&mut self, now: Duration, frame: &[u8]);
+    /// Runs the deadlines up to `now`.
+    fn handle_timeout(&mut self, now: Duration);
+    /// The next frame to send at `now`.
+    fn poll_transmit(&mut self, now: Duration) -> Option<Vec<u8>>;
+    /// When the station has work next.
+    fn poll_timeout(&self) -> Option<Duration>;
+}
 pub use identity::{Identity, IdentityError};

@@ -949,47 +949,6 @@ fn a_refused_parameter_record_stops_the_start_up() {
     assert!(!p.dev_events.contains(&DeviceEvent::PrmEnd));
 }
 
-fn identify_all(d: &mut Device, xid: u32, blocks: &[u8]) -> bool {
-    let pdu = dcp::pdu(
-        FrameId::DCP_IDENTIFY_REQ,
-        service::IDENTIFY,
-        service_type::REQUEST,
-        xid,
-        1,
-        blocks,
-    );
-    d.handle_frame(
-        Duration::ZERO,
-        &eth::frame(
-            eth::DCP_IDENTIFY_MAC,
-            CTL_MAC,
-            None,
-            ethertype::PROFINET,
-            &pdu,
-        ),
-    );
-    d.poll_transmit(Duration::ZERO).is_some()
-}
-
-#[test]
-fn a_planted_dcp_fault_silences_the_device_after_a_malformed_identify() {
-    let all = [0xFF, 0xFF, 0x00, 0x00];
-    // A block whose DCPBlockLength runs past the PDU.
-    let malformed = [0x02, 0x02, 0x00, 0x40, b'x'];
-    let mut good = device();
-    assert!(!identify_all(&mut good, 1, &malformed));
-    assert!(
-        identify_all(&mut good, 2, &all),
-        "a correct device keeps answering"
-    );
-    let mut c = DeviceConfig::new(spec(), "PSD426", DEV_MAC, NAME).unwrap();
-    c.fault = Some(drivespec_profinet::Fault::DcpDeafAfterMalformedIdentify);
-    let mut bad = Device::new(spec(), c).unwrap();
-    assert!(identify_all(&mut bad, 1, &all));
-    assert!(!identify_all(&mut bad, 2, &malformed));
-    assert!(!identify_all(&mut bad, 3, &all), "the planted fault");
-}
-
 #[test]
 fn both_stations_answer_arp_for_their_address() {
     use drivespec_capture::arp::{parse_arp, Arp, REPLY, REQUEST};
