@@ -78,7 +78,7 @@ pub struct HpdSession<'a, 's> {
 /// Attempts of a case on real time while its timing stays undecided (the runner's own
 /// delays, not the device's): three make a device that is late every time fail, and a
 /// runner starved once by other work on the machine pass.
-pub const ATTEMPTS: usize = 3;
+const ATTEMPTS: usize = 3;
 
 /// How late the runner may wake at the end of an answer window and still count as on time
 /// (µs): on a machine with a core to spare a thread wakes well within 2 ms of its deadline.
@@ -800,6 +800,9 @@ impl<'a, 's> HpdSession<'a, 's> {
         if got.is_empty() {
             return None;
         }
+        if unstuffed(rules, got) {
+            return Some("HPD-FRAME-003".to_owned());
+        }
         let exp = drivespec_hpd::parse(rules, expected).ok();
         let dev = drivespec_hpd::parse(rules, got).ok();
         let rule = match (exp, dev) {
@@ -875,8 +878,10 @@ impl<'a, 's> HpdSession<'a, 's> {
     }
 }
 
-/// The rules of a message's form (manual 4.1), which a response with the right address,
-/// LUN, PAR, byte order, checksum and stuffing keeps whatever value it carries.
+/// The rules of a read and of an answer's form (manual 4.1), which a response with the right
+/// address, LUN, PAR, byte order, checksum and stuffing keeps whatever value it carries. The
+/// rules of what a write means (CMD 3, 5, 6, 7) are not among them: a write the drive
+/// misreads shows in the values read after it.
 const FORM: &[&str] = &[
     "HPD-FRAME-001",
     "HPD-FRAME-002",
@@ -888,13 +893,7 @@ const FORM: &[&str] = &[
     "HPD-FRAME-010",
     "HPD-FRAME-011",
     "HPD-FRAME-012",
-    "HPD-FRAME-013",
     "HPD-FRAME-014",
-    "HPD-FRAME-015",
-    "HPD-FRAME-016",
-    "HPD-FRAME-017",
-    "HPD-FRAME-018",
-    "HPD-FRAME-019",
     "HPD-FRAME-022",
     "HPD-SERIAL-001",
     "HPD-SERIAL-015",
@@ -914,6 +913,26 @@ fn frame_rule_broken(rules: &drivespec_hpd::FrameRules, got: &[u8]) -> Option<&'
         Err(drivespec_hpd::FrameError::Stuffing { .. }) => Some("HPD-FRAME-003"),
         _ => None,
     }
+}
+
+/// Whether `got` lacks the $00 the manual puts after a $7E inside a message (4.1 STX): it
+/// does not decode, and decodes with the $00 put back.
+fn unstuffed(rules: &drivespec_hpd::FrameRules, got: &[u8]) -> bool {
+    let from = got.iter().position(|b| *b == rules.stx).unwrap_or(0);
+    let Some(body) = got.get(from..) else {
+        return false;
+    };
+    if drivespec_hpd::parse(rules, body).is_ok() {
+        return false;
+    }
+    let mut stuffed = Vec::with_capacity(body.len() * 2);
+    for (i, b) in body.iter().enumerate() {
+        stuffed.push(*b);
+        if i > 0 && *b == rules.stx {
+            stuffed.push(rules.stuff);
+        }
+    }
+    stuffed.len() > body.len() && drivespec_hpd::parse(rules, &stuffed).is_ok()
 }
 
 /// Whether the device's bytes `got` fit the reference's `exp` as `judge` compares them.
@@ -1175,6 +1194,13 @@ impl HpdSession<'_, '_> {
         }
         self.saved.clear();
         self.split_from = None;
+        // What a failure may cite: the case's own requirements first, as declared.
+        let mut order: Vec<String> = case.checks.clone();
+        for r in &info.requirements {
+            if !order.contains(r) {
+                order.push(r.clone());
+            }
+        }
         self.journal.begin(&self.oracle);
         let mut findings: Vec<Finding> = Vec::new();
         let mut cited: Vec<String> = info.requirements.clone();
@@ -1515,7 +1541,7 @@ impl HpdSession<'_, '_> {
                         }
                         if !ok {
                             let mut requirements = self.requirement_refs(
-                                &info.requirements,
+                                &order,
                                 Some(step),
                                 &exp_bytes,
                                 &rec.got.as_ref().map_or_else(Vec::new, |a| {
@@ -1560,7 +1586,7 @@ impl HpdSession<'_, '_> {
                             expected: show(&ea),
                             got: e.to_string(),
                             requirements: self.requirement_refs(
-                                &info.requirements,
+                                &order,
                                 Some(step),
                                 &concat(&expected),
                                 &[],
@@ -1747,7 +1773,11 @@ impl HpdSession<'_, '_> {
                             None,
                         ));
                         rec.got = Some(self.answer(&got, sent, None));
-                        let broken = frame_rule_broken(&rules, &bytes).unwrap_or(NO_RESPONSE);
+                        let broken = if unstuffed(&rules, &bytes) {
+                            "HPD-FRAME-003"
+                        } else {
+                            frame_rule_broken(&rules, &bytes).unwrap_or(NO_RESPONSE)
+                        };
                         rec.note = Some(format!(
                             "no response to the read of {} byte(s) at {:#04x}: {}",
                             probe.lun,
