@@ -13,12 +13,16 @@
 //!
 //! On real time the runner tells its own delays from the device's. The runner's clock
 //! measures how late it woke at the end of an answer window, and how long the parts of a
-//! split message were apart when it sent them. A late answer while the runner itself woke
-//! late, or silence to a split message whose parts the runner sent so far apart that the
-//! transport's slack could carry the rest past the time-out, is undecided: the case runs
-//! again, up to [`ATTEMPTS`] times; on the last attempt it passes with an open finding.
-//! A late answer while the runner was on time fails on the last attempt. On virtual time
-//! (sim) the runner is always on time and every case runs once.
+//! split message were apart when it sent them. A late answer, or silence to a split message
+//! whose parts the runner sent so far apart that the transport's slack could carry the rest
+//! past the time-out, is undecided: the case runs again, up to [`ATTEMPTS`] times. On the
+//! last attempt a late answer fails if the runner woke on time and passes with an open
+//! finding if it did not; silence to a late rest passes with an open finding. A case that
+//! fails after an answer went missing (not come by the end of its late window) is undecided
+//! too, and so is an answer to the rest of a message the runner sent past the time-out: a
+//! stalled machine stalls a device process on it, and a device that does not answer, or
+//! ignores the time-out, fails every attempt. On virtual time (sim) the runner is always on time and every case
+//! runs once.
 //!
 //! A message split by a pause within the time-out pauses half the time-out, at most the
 //! time-out less the slack. The first failing step ends the judged part of a case; its
@@ -73,6 +77,9 @@ pub struct HpdSession<'a, 's> {
     last_attempt: bool,
     /// Why this attempt of the case is undecided: the case runs again.
     undecided: Option<String>,
+    /// An answer of this attempt had not come by the end of its late window, or came after
+    /// it: on real time the line's state is unsure, and a failure of the attempt undecided.
+    missed: bool,
 }
 
 /// Attempts of a case on real time while its timing stays undecided (the runner's own
@@ -160,6 +167,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             split_from: None,
             last_attempt: true,
             undecided: None,
+            missed: false,
         };
         session.oracle = session.base();
         session
@@ -464,6 +472,9 @@ impl<'a, 's> HpdSession<'a, 's> {
             }
         }
         let late_at = got.iter().map(|c| c.at).find(|at| *at > end);
+        if concat(&got).len() < want {
+            self.missed = true;
+        }
         self.owed = 0;
         Ok(Observed {
             expected,
@@ -512,6 +523,9 @@ impl<'a, 's> HpdSession<'a, 's> {
         if let Ok(c) = self.link.recv(now + 1, &mut |_| false) {
             late.extend(concat(&c));
         }
+        if !late.is_empty() {
+            self.missed = true;
+        }
         late
     }
 
@@ -539,6 +553,18 @@ impl<'a, 's> HpdSession<'a, 's> {
                 }
                 _ => Timing::Clean,
             };
+        }
+        if let (false, false, true, Some(span)) =
+            (fits, obs.got.is_empty(), ref_silent, obs.split_span)
+        {
+            let (timeout, _, _) = self.line_times();
+            if span >= timeout && !self.link.caps().virtual_time && !self.last_attempt {
+                return Timing::Undecided(format!(
+                    "the rest of the message went out {:.1} ms after its first part, past the {:.1} ms time-out; a device process stalled between them reads both within it",
+                    ms(span),
+                    ms(timeout)
+                ));
+            }
         }
         let Some(at) = obs.late_at.filter(|_| fits) else {
             return Timing::Clean;
@@ -1119,11 +1145,21 @@ impl HpdSession<'_, '_> {
         loop {
             self.last_attempt = attempt >= attempts;
             self.undecided = None;
+            self.missed = false;
             let mut run = self.attempt(info, case, from_start);
+            if self.missed && matches!(run.outcome, Outcome::Fail(_)) && self.undecided.is_none() {
+                self.undecided = Some(
+                    "an answer did not come within its late window: the device or the machine stalled".to_owned(),
+                );
+            }
             match self.undecided.take() {
                 Some(reason) if !self.last_attempt => {
                     why.push(format!("attempt {attempt}: {reason}"));
                     attempt += 1;
+                    // Answers still on their way are not taken for the next attempt's.
+                    let settle = self.link.now() + self.late_window();
+                    let _ = self.link.recv(settle, &mut |_| false);
+                    self.owed = 0;
                 }
                 _ => {
                     self.last_attempt = true;
@@ -1373,10 +1409,6 @@ impl HpdSession<'_, '_> {
                         // the message past the time-out is shortened, to none at the least.
                         _ => (timeout / 2).min(timeout.saturating_sub(self.slack)),
                     };
-                    if matches!(step.action, Action::ListenTimeout {}) {
-                        // The part sent so far is dropped at the time-out.
-                        self.split_from = None;
-                    }
                     rec.note = Some(format!("listened {us} µs"));
                     match self.listen(us) {
                         Ok(obs) => {
