@@ -18,11 +18,13 @@
 //! past the time-out, is undecided: the case runs again, up to [`ATTEMPTS`] times. On the
 //! last attempt a late answer fails if the runner woke on time and passes with an open
 //! finding if it did not; silence to a late rest passes with an open finding. A case that
-//! fails after an answer went missing (not come by the end of its late window) is undecided
-//! too, and so is an answer to the rest of a message the runner sent past the time-out: a
-//! stalled machine stalls a device process on it, and a device that does not answer, or
-//! ignores the time-out, fails every attempt. On virtual time (sim) the runner is always on time and every case
-//! runs once.
+//! fails after an answer went missing (not come by the end of its late window) while the
+//! runner itself woke late from a 1 ms wait is undecided too, and so is an answer to the rest
+//! of a message the runner sent past the time-out: a stalled machine stalls a device process
+//! on it, and a device that does not answer, or ignores the time-out, fails every attempt. A
+//! missing answer while the runner was on time is the device's (a lossy line fails the case;
+//! the runner's `--retries` reports it flaky). On virtual time (sim) the runner is always on
+//! time and every case runs once.
 //!
 //! A message split by a pause within the time-out pauses half the time-out, at most the
 //! time-out less the slack. The first failing step ends the judged part of a case; its
@@ -80,6 +82,8 @@ pub struct HpdSession<'a, 's> {
     /// An answer of this attempt had not come by the end of its late window, or came after
     /// it: on real time the line's state is unsure, and a failure of the attempt undecided.
     missed: bool,
+    /// The runner woke later than [`RUNNER_ON_TIME_US`] from a short wait of this attempt.
+    runner_late: bool,
 }
 
 /// Attempts of a case on real time while its timing stays undecided (the runner's own
@@ -90,6 +94,9 @@ const ATTEMPTS: usize = 3;
 /// How late the runner may wake at the end of an answer window and still count as on time
 /// (µs): on a machine with a core to spare a thread wakes well within 2 ms of its deadline.
 const RUNNER_ON_TIME_US: Micros = 2_000;
+
+/// The short sleep from which the runner measures how late it wakes (µs).
+const PROBE_US: Micros = 1_000;
 
 /// The requirement that fixes when the drive answers: at once, or 25 ms later with Pr26 = 4
 /// (4 table note (*)).
@@ -168,6 +175,7 @@ impl<'a, 's> HpdSession<'a, 's> {
             last_attempt: true,
             undecided: None,
             missed: false,
+            runner_late: false,
         };
         session.oracle = session.base();
         session
@@ -462,9 +470,12 @@ impl<'a, 's> HpdSession<'a, 's> {
         };
         let end = t0 + window;
         let mut woke_late = 0;
+        if concat(&got).len() < want {
+            woke_late = self.link.now().saturating_sub(end);
+            self.probe_runner();
+        }
         let have = concat(&got).len();
         if have < want {
-            woke_late = self.link.now().saturating_sub(end);
             let until = end + self.late_window();
             match self.link.recv(until, &mut |b| have + b.len() >= want) {
                 Ok(more) => got.extend(more),
@@ -485,6 +496,21 @@ impl<'a, 's> HpdSession<'a, 's> {
             woke_late,
             split_span,
         })
+    }
+
+    /// Measures how late the runner's own thread wakes from a short sleep (its scheduling
+    /// delay now, on the monotonic clock, apart from the transport); bytes that come
+    /// meanwhile wait in the transport.
+    fn probe_runner(&mut self) {
+        if self.link.caps().virtual_time {
+            return;
+        }
+        let start = std::time::Instant::now();
+        std::thread::sleep(std::time::Duration::from_micros(PROBE_US));
+        let slept = u64::try_from(start.elapsed().as_micros()).unwrap_or(Micros::MAX);
+        if slept.saturating_sub(PROBE_US) > RUNNER_ON_TIME_US {
+            self.runner_late = true;
+        }
     }
 
     /// How long an answer not come by the end of its window is still waited for: the window
@@ -1146,10 +1172,15 @@ impl HpdSession<'_, '_> {
             self.last_attempt = attempt >= attempts;
             self.undecided = None;
             self.missed = false;
+            self.runner_late = false;
             let mut run = self.attempt(info, case, from_start);
-            if self.missed && matches!(run.outcome, Outcome::Fail(_)) && self.undecided.is_none() {
+            if self.missed
+                && self.runner_late
+                && matches!(run.outcome, Outcome::Fail(_))
+                && self.undecided.is_none()
+            {
                 self.undecided = Some(
-                    "an answer did not come within its late window: the device or the machine stalled".to_owned(),
+                    "an answer did not come within its late window while the runner itself woke late: the machine stalled".to_owned(),
                 );
             }
             match self.undecided.take() {
