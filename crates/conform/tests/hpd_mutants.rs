@@ -1,7 +1,7 @@
 //! Mutation tests: the reference drive with one planted deviation (`drivespec_implementations::hpd_mutants`) as the
 //! device under test. Each mutant must fail at least the cases named for it, and every case it
-//! fails must cite one of the requirements the deviation breaks (no collateral failures). The
-//! score is printed. A mutant following another reading of an erratum is judged with the
+//! fails must cite one of the requirements the deviation breaks first (no collateral failures,
+//! no failure led by another requirement). The score is printed. A mutant following another reading of an erratum is judged with the
 //! adopted reading made strict (`--reading OPTION=ADOPTED`): by default that reading is legal.
 #![allow(
     clippy::unwrap_used,
@@ -26,6 +26,7 @@ fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
     let mut caught = 0;
     let mut report = Vec::new();
     let mut problems = Vec::new();
+    let mut led_by_effect: Vec<&str> = Vec::new();
     let all = mutants();
     for m in &all {
         let strict_suite;
@@ -56,6 +57,24 @@ fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
                         "{}: collateral failure {} ({})",
                         m.name, info.id, f.message
                     ));
+                } else if !f
+                    .requirements
+                    .first()
+                    .is_some_and(|r| m.breaks.contains(&r.id))
+                {
+                    let led = format!(
+                        "{}: {} fails citing {:?} first, not one of {:?} ({})",
+                        m.name,
+                        info.id,
+                        f.requirements.first().map(|r| r.id.as_str()),
+                        m.breaks,
+                        f.message
+                    );
+                    if LED_BY_ITS_EFFECT.iter().any(|(name, _)| *name == m.name) {
+                        led_by_effect.push(m.name);
+                    } else {
+                        problems.push(led);
+                    }
                 }
                 failed.push(info.id.clone());
             }
@@ -82,10 +101,42 @@ fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
         all.len(),
         100.0 * caught as f64 / all.len() as f64
     );
+    for (name, why) in LED_BY_ITS_EFFECT {
+        let n = led_by_effect.iter().filter(|m| **m == name).count();
+        println!("{name}: {n} case(s) led by the requirement of the effect ({why})");
+        if n == 0 {
+            problems.push(format!(
+                "{name}: every failure now leads with a requirement it breaks; take it off LED_BY_ITS_EFFECT"
+            ));
+        }
+    }
     assert!(all.len() >= 12);
     assert!(problems.is_empty(), "{}", problems.join("\n"));
     assert_eq!(caught, all.len());
 }
+
+/// Mutants whose deviation hits a set-up step that no check verifies on its own (a bit
+/// change, the inputs, a watch's samples): the case that fails cites the behaviour its check
+/// evaluates first, and the broken requirement further down. Each must still show such a
+/// case; one whose failures all lead with a requirement it breaks is taken off.
+const LED_BY_ITS_EFFECT: [(&str, &str); 4] = [
+    (
+        "wrong bit-change byte",
+        "set-up bit changes of the high byte (b99.13, b90.8..15) are not read back",
+    ),
+    (
+        "digital inputs never read",
+        "the inputs applied before a PLC vector are not read back from b90.0..b90.7",
+    ),
+    (
+        "big-endian data",
+        "a watch judges the values of its samples, not their byte order",
+    ),
+    (
+        "b99.3 set for non-zero results",
+        "vectors whose first requirement is another instruction's read b99.3 with the rest of Pb99",
+    ),
+];
 
 /// What a CI log shows first for a failure: the broken requirement, then what went wrong,
 /// what the manual allows and what came.
@@ -198,6 +249,19 @@ fn every_motion_mutant_fails_citing_its_requirement_first() {
                     problems.push(format!(
                         "{}: collateral failure {} ({})",
                         m.name, info.id, f.message
+                    ));
+                } else if !f
+                    .requirements
+                    .first()
+                    .is_some_and(|r| m.breaks.contains(&r.id.as_str()))
+                {
+                    problems.push(format!(
+                        "{}: {} fails citing {:?} first, not one of {:?} ({})",
+                        m.name,
+                        info.id,
+                        f.requirements.first().map(|r| r.id.as_str()),
+                        m.breaks,
+                        f.message
                     ));
                 }
                 failed.push((

@@ -79,6 +79,7 @@ impl<'a, 's> HpdTarget<'a, 's> {
                 .any(|s| s.action == Action::Hpd(HAction::PowerCycle {})),
             touched: self.touched(steps),
             steps: hsteps,
+            checks: Vec::new(),
         };
         Ok((info, case))
     }

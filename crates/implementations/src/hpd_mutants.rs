@@ -41,9 +41,15 @@ pub enum Kind {
     DeafInputs,
     /// The volatile user flags of Pb91 survive power-up.
     KeepsVolatileFlags,
+    /// Every answer delayed by 25 ms whatever Pr26, as if every code were code 4 (4 table
+    /// note (*)).
+    AnswersLate,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
+
+/// The answer delay of Pr26 = 4 (4 table note (*)), which `AnswersLate` adds on every code.
+const ANSWER_DELAY_US: Micros = 25_000;
 
 /// A drive with a deviation.
 #[derive(Clone)]
@@ -403,6 +409,11 @@ impl SimDevice for Mutant {
         }
         match self.inner.poll_output()? {
             Output::Transmit { at, bytes } => {
+                let at = if self.kind == Kind::AnswersLate {
+                    at + ANSWER_DELAY_US
+                } else {
+                    at
+                };
                 if self.drop_ack && matches!(parse(&self.rules, &bytes), Ok(Message::Ack { .. })) {
                     self.drop_ack = false;
                     return self.poll_output();
@@ -600,6 +611,12 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::KeepsVolatileFlags,
             breaks: v(&["HPD-BIT-91-POWER-ON"]),
             must_fail: &["hpd/cmd/power-up/Pb91"],
+        },
+        Case {
+            name: "every answer 25 ms late",
+            kind: Kind::AnswersLate,
+            breaks: v(&["HPD-BAUD-004"]),
+            must_fail: &["hpd/frame/read-parameter", "hpd/param/Pr33/min"],
         },
         Case {
             name: "command bits stay set",

@@ -836,6 +836,7 @@ impl<'s> Gen<'s> {
             steps: cb.steps,
             needs_power_cycle: cb.needs_power_cycle,
             touched: cb.touched,
+            checks: cb.explicit.into_iter().filter(|r| self.known(r)).collect(),
         };
         self.cases.push((info, case));
     }

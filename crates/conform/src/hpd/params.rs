@@ -525,11 +525,13 @@ fn one_bit(
             p.id
         )
     };
-    let mut cb = CaseB::new(
-        format!("{prefix}/{verb}"),
-        text,
-        &["HPD-FRAME-017", "HPD-FRAME-018"],
-    );
+    // The byte PAR names (CMD 6) is what a bit of the high byte checks first.
+    let cmd6 = if b.bit >= 8 {
+        ["HPD-FRAME-018", "HPD-FRAME-017"]
+    } else {
+        ["HPD-FRAME-017", "HPD-FRAME-018"]
+    };
+    let mut cb = CaseB::new(format!("{prefix}/{verb}"), text, &cmd6);
     let own_req = format!("HPD-BIT-{}-{}", p.number, b.bit);
     if g.known(&own_req) {
         cb.reqs([own_req]);

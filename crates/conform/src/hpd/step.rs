@@ -28,4 +28,7 @@ pub struct HpdCase {
     pub needs_power_cycle: bool,
     /// Parameter slots the case may change (resynchronised after a failure).
     pub touched: Vec<Slot>,
+    /// The requirements the case itself checks, in the order declared: a value that differs
+    /// breaks the first of them that is not a rule of the message form.
+    pub checks: Vec<String>,
 }
