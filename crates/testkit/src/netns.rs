@@ -128,6 +128,11 @@ impl NsChild {
         }
     }
 
+    /// The process id.
+    pub fn id(&self) -> u32 {
+        self.child.id()
+    }
+
     /// Reads stdout until a line containing `marker` (libtest may print its own words before
     /// it on the same line), and returns the rest of that line; panics when stdout ends first.
     pub fn wait_line(&mut self, marker: &str) -> String {
