@@ -19,7 +19,8 @@
 //! These are test fixtures, not a library for users (unpublished): they are built from the
 //! built-in spec and end with a panic when it does not load.
 //! Their `unwrap`s read names and tables of the built-in spec or re-encode messages built
-//! from frames that decoded; none depends on what a runner sends them.
+//! from frames that decoded; none depends on what a runner sends them (values a runner can
+//! set, such as parameters, are converted without `unwrap`).
 #![forbid(unsafe_code)]
 #![allow(
     missing_docs,

@@ -201,10 +201,15 @@ impl<'s> Mutant<'s> {
                 let margin = end - upper;
                 let t = i64::from(*target);
                 let transferred = *word & control_bit(&self.drive, "Transfer target values") != 0;
-                if transferred && t > upper && t <= end {
-                    *target = i32::try_from(upper).unwrap();
+                let limit = if transferred && t > upper && t <= end {
+                    Some(upper)
                 } else if transferred && t < lower && t >= lower - margin {
-                    *target = i32::try_from(lower).unwrap();
+                    Some(lower)
+                } else {
+                    None
+                };
+                if let Some(l) = limit.and_then(|l| i32::try_from(l).ok()) {
+                    *target = l;
                 }
             }
             _ => {}
@@ -256,7 +261,7 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                 *control_word &= !mask;
                 if self.kind == Kind::SpeedZeroNoFallback && *target_speed == 0 {
                     let half = int(&self.drive, "142") / 2;
-                    *target_speed = i16::try_from(half.max(1)).unwrap();
+                    *target_speed = i16::try_from(half.max(1)).unwrap_or(i16::MAX);
                 }
             }
             Output::TimeStamp { .. } => {}
@@ -414,11 +419,11 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                     e.name.starts_with("DeviceID") && e.address + dp.subindex_offset == subindex
                 });
                 match (entry, &reply) {
-                    (Some(e), Reply::Data(_)) => {
-                        let code = u32::try_from(int(&self.drive, "79")).unwrap();
-                        let page = rules.direct_page(rules.default_format(), code).unwrap();
-                        Reply::Data(vec![page[usize::from(e.address)]])
-                    }
+                    (Some(e), Reply::Data(_)) => u32::try_from(int(&self.drive, "79"))
+                        .ok()
+                        .and_then(|code| rules.direct_page(rules.default_format(), code).ok())
+                        .and_then(|page| page.get(usize::from(e.address)).copied())
+                        .map_or(reply, |b| Reply::Data(vec![b])),
                     _ => reply,
                 }
             }
@@ -437,8 +442,11 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                     control_bit(&self.drive, "Release") | control_bit(&self.drive, "Readjustment");
                 let forwards = int(&self.drive, "134") == 0;
                 let against = (n < 0) == forwards;
-                if ok && aborted && against && self.last_control & enabled == enabled {
-                    let target = i32::try_from(self.drive.target()).unwrap();
+                let target = i32::try_from(self.drive.target()).ok();
+                if let (true, Some(target)) = (
+                    ok && aborted && against && self.last_control & enabled == enabled,
+                    target,
+                ) {
                     let transfer = control_bit(&self.drive, "Transfer target values");
                     for control_word in
                         [self.last_control & !transfer, self.last_control | transfer]
@@ -447,7 +455,9 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                             control_word,
                             target,
                         };
-                        self.drive.handle_output(now, &out).unwrap();
+                        if self.drive.handle_output(now, &out).is_err() {
+                            break;
+                        }
                     }
                     while self.drive.poll_input().is_some() {}
                 }

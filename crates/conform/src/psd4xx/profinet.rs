@@ -30,6 +30,7 @@ use drivespec_profinet::status::{self, rw};
 use drivespec_profinet::{
     Controller, ControllerConfig, ControllerError, ControllerEvent, RecordId,
 };
+use drivespec_spec::hex::to_hex_compact as hex;
 use drivespec_wire::{Filter, OpenOptions, RawSocket};
 use std::net::UdpSocket;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
@@ -475,10 +476,6 @@ impl Drop for ProfinetPeer {
             let _ = t.join();
         }
     }
-}
-
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02X}")).collect()
 }
 
 /// `Ok` for a write the drive took; what `RESET` got otherwise.
