@@ -1714,3 +1714,53 @@ impl<'s, F: CyclicFamily<'s>> Session for CyclicSession<'_, F> {
         self.run_suite_case(&info, &case)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{reversal_stops, steepest};
+
+    #[test]
+    fn steepest_counts_a_change_per_the_requests_interval_when_the_images_lie_further_apart() {
+        // 10 ms requests; the second image was taken 20 ms after the first.
+        let late = [Some((0, 0, 0)), Some((20, 10_000, 20_000))];
+        assert_eq!(steepest(late.into_iter()).0, 10);
+        // Taken on time (virtual time): the change counts whole.
+        let on_time = [Some((0, 0, 0)), Some((20, 10_000, 10_000))];
+        assert_eq!(steepest(on_time.into_iter()).0, 20);
+        // Taken closer together than requested: never counted steeper.
+        let early = [Some((0, 0, 0)), Some((20, 10_000, 5_000))];
+        assert_eq!(steepest(early.into_iter()).0, 20);
+    }
+
+    #[test]
+    fn a_stop_near_moving_samples_of_opposite_directions_is_a_reversal_and_nothing_else_is() {
+        const RUNNING: u16 = 0x0040;
+        let samples = |s: &[(i64, u16)]| {
+            let s = s.to_vec();
+            reversal_stops(s.len(), RUNNING, move |i| s.get(i).copied())
+        };
+        // Down, a one-sample stop, up: the stop is a reversal.
+        assert_eq!(
+            samples(&[(-10, RUNNING), (0, 0), (10, RUNNING)]),
+            [false, true, false]
+        );
+        // Down, a stop, down again: a stop in the run, not a reversal.
+        assert_eq!(
+            samples(&[(-10, RUNNING), (0, 0), (-10, RUNNING)]),
+            [false, false, false]
+        );
+        // A stop too far from moving samples on both sides.
+        assert_eq!(
+            samples(&[
+                (-10, RUNNING),
+                (0, 0),
+                (0, 0),
+                (0, 0),
+                (0, 0),
+                (0, 0),
+                (10, RUNNING)
+            ]),
+            [false; 7]
+        );
+    }
+}
