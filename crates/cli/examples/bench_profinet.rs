@@ -11,7 +11,7 @@
 //! positioning sequence).
 #![allow(clippy::expect_used, clippy::unwrap_used, clippy::indexing_slicing)]
 
-use drivespec_capture::dcerpc::{self, PacketType};
+use drivespec_capture::dcerpc::{self, PacketType, PNIO_PORT};
 use drivespec_capture::ip::parse_ipv4_udp;
 use drivespec_capture::link::{ethertype, parse_ethernet};
 use drivespec_capture::pcap::CaptureReader;
@@ -19,9 +19,6 @@ use drivespec_capture::rt::{FrameClass, RtFrame};
 use drivespec_testkit::netns::{NetnsPair, NsChild};
 use std::collections::BTreeMap;
 use std::time::Duration;
-
-/// The PNIO-CM port of the device (IEC 61158-6-10).
-const PNIO_PORT: u16 = 0x8894;
 
 /// Clock ticks per second of `/proc/PID/stat` (`getconf CLK_TCK` on Linux).
 const TICKS: u64 = 100;
