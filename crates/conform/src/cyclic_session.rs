@@ -248,13 +248,27 @@ pub trait CyclicFamily<'s> {
     fn exact_equal(&self, device: &Self::Input, reference: &Self::Input) -> bool;
     /// The "Drive is running" status bit.
     fn running_bit(&self) -> u16;
-    /// The requirements a differing cycle cites: the case's plus those of what differs.
+    /// The requirements a differing cycle cites, the one the device broke first: those of
+    /// what differs, as far as the images show it, and the case's (`case`, declared order).
+    /// `out` is the output image both sides were sent.
     fn cited(
         &self,
         case: &[String],
+        out: &Self::Output,
         dut: Option<&Self::Input>,
         reference: &Self::Input,
     ) -> Vec<String>;
+    /// The requirements a differing reply to `req` cites, the one the device broke first
+    /// (what the reply shows), then the case's (`case`, declared order).
+    fn reply_cited(
+        &self,
+        case: &[String],
+        _req: &Request,
+        _expected: &Reply,
+        _got: &Reply,
+    ) -> Vec<String> {
+        case.to_vec()
+    }
     /// Whether the device's reply to `req` conforms to the reference's, with a remark for the
     /// evidence when it conforms other than by equality.
     fn same_reply(
@@ -559,9 +573,9 @@ struct Divergence<T> {
 /// ahead of it) on the device and on the reference, values for which `skip` holds left out: the first change that differs in
 /// value, or that the device makes in a step before the stimulus of the reference's (a
 /// reaction may come later than the reference's, never before its stimulus).
-fn first_difference<I, T: PartialEq + Clone>(
-    before: Option<&Cycle<I>>,
-    segment: &[Cycle<I>],
+fn first_difference<I, O, T: PartialEq + Clone>(
+    before: Option<&Cycle<I, O>>,
+    segment: &[Cycle<I, O>],
     from: usize,
     value: impl Fn(&I) -> T,
     skip: impl Fn(&T) -> bool,
@@ -657,15 +671,17 @@ fn first_difference<I, T: PartialEq + Clone>(
 }
 
 /// " in step N" for a cycle, empty for none.
-fn step_of<I>(cycles: &[Cycle<I>], at: Option<usize>) -> String {
+fn step_of<I, O>(cycles: &[Cycle<I, O>], at: Option<usize>) -> String {
     at.and_then(|i| cycles.get(i))
         .map(|c| format!(" in step {}", c.step))
         .unwrap_or_default()
 }
 
 /// One cycle as both sides saw it.
-struct Cycle<I> {
+struct Cycle<I, O> {
     step: usize,
+    /// The output image both sides were sent.
+    out: O,
     t: u64,
     /// When the device's image was taken (µs; `t` on virtual time).
     taken: u64,
@@ -681,7 +697,7 @@ struct Run<'r, 's, I, O> {
     t: u64,
     /// The step being run.
     step: usize,
-    cycles: Vec<Cycle<I>>,
+    cycles: Vec<Cycle<I, O>>,
     evidence: Vec<Record>,
     failure: Option<Failure>,
     /// The cycle that shows the failure, when one does (marked on the plot).
@@ -763,6 +779,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 self.device.failed(&e);
                 run.cycles.push(Cycle {
                     step,
+                    out: run.out.clone(),
                     t: run.t,
                     taken: run.t,
                     reference,
@@ -773,6 +790,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         };
         run.cycles.push(Cycle {
             step,
+            out: run.out.clone(),
             t: run.t,
             taken: self.device.taken_at().unwrap_or(run.t),
             reference,
@@ -855,7 +873,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 message: format!("step {step} ({text}): the reply differs from the reference"),
                 expected: expected.to_string(),
                 got: got_text,
-                requirements: self.refs(run.reqs),
+                requirements: self.refs(&match &got {
+                    Some(g) => self.family.reply_cited(run.reqs, &req, &expected, g),
+                    None => run.reqs.to_vec(),
+                }),
             });
         }
         ok
@@ -1181,7 +1202,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 speed != 0 || status & running != 0
             });
         let end = run.cycles.len();
-        let motion = |c: &Cycle<F::Input>, dut: bool| {
+        let motion = |c: &Cycle<F::Input, F::Output>, dut: bool| {
             let i = if dut {
                 c.dut.as_ref().ok()?
             } else {
@@ -1538,7 +1559,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         &self,
         reqs: &[String],
         i: usize,
-        c: &Cycle<F::Input>,
+        c: &Cycle<F::Input, F::Output>,
         reference: &F::Input,
         what: String,
     ) -> Failure {
@@ -1556,7 +1577,12 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             ),
             expected: self.family.describe(reference),
             got,
-            requirements: self.refs(&self.family.cited(reqs, c.dut.as_ref().ok(), reference)),
+            requirements: self.refs(&self.family.cited(
+                reqs,
+                &c.out,
+                c.dut.as_ref().ok(),
+                reference,
+            )),
         }
     }
 

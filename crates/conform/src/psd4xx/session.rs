@@ -216,7 +216,13 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
     /// at a time) when the PKW block differs, the speed (par. 2) and position (par. 3) rules
     /// when those differ, and the set/reset rules of every status bit that differs (spec
     /// bitfield `status`).
-    fn cited(&self, case: &[String], dut: Option<&Input>, reference: &Input) -> Vec<String> {
+    fn cited(
+        &self,
+        case: &[String],
+        _out: &Output,
+        dut: Option<&Input>,
+        reference: &Input,
+    ) -> Vec<String> {
         let mut ids = case.to_vec();
         let mut add = |id: &str| {
             if !ids.iter().any(|x| x == id) {

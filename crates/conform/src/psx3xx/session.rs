@@ -223,7 +223,13 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
 
     /// The case's requirements; first the byte order of the process data (PSX-PD-008) when
     /// the device's status word is the reference's with its two octets swapped.
-    fn cited(&self, case: &[String], dut: Option<&Input>, reference: &Input) -> Vec<String> {
+    fn cited(
+        &self,
+        case: &[String],
+        _out: &Output,
+        dut: Option<&Input>,
+        reference: &Input,
+    ) -> Vec<String> {
         let swapped = dut.is_some_and(|d| {
             d.status != reference.status && d.status == reference.status.swap_bytes()
         });
