@@ -116,10 +116,10 @@ fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
 }
 
 /// Mutants whose deviation hits a set-up step that no check verifies on its own (a bit
-/// change, the inputs, a watch's samples): the case that fails cites the behaviour its check
+/// change, the inputs): the case that fails cites the behaviour its check
 /// evaluates first, and the broken requirement further down. Each must still show such a
 /// case; one whose failures all lead with a requirement it breaks is taken off.
-const LED_BY_ITS_EFFECT: [(&str, &str); 4] = [
+const LED_BY_ITS_EFFECT: [(&str, &str); 2] = [
     (
         "wrong bit-change byte",
         "set-up bit changes of the high byte (b99.13, b90.8..15) are not read back",
@@ -127,14 +127,6 @@ const LED_BY_ITS_EFFECT: [(&str, &str); 4] = [
     (
         "digital inputs never read",
         "the inputs applied before a PLC vector are not read back from b90.0..b90.7",
-    ),
-    (
-        "big-endian data",
-        "a watch judges the values of its samples, not their byte order",
-    ),
-    (
-        "b99.3 set for non-zero results",
-        "vectors whose first requirement is another instruction's read b99.3 with the rest of Pb99",
     ),
 ];
 
