@@ -1,7 +1,8 @@
 //! Which requirement the bytes of a failing HPD answer break, by what differs from the
 //! reference's (manual 4.1; 3.3, 3.8.1 bit tables): a response whose data differ only in bits
 //! of a bit parameter breaks the rule of those bits; one whose data are the reference's in
-//! reverse order breaks the byte order, unless the device showed the right order before.
+//! reverse order breaks the byte order, unless the device showed the right order before; a
+//! bit change read back without the bits it wrote breaks the rule of its mask or of its PAR.
 
 use drivespec_hpd::{Data, FrameRules, Message};
 use drivespec_spec::{Family, RuleAction};
@@ -83,6 +84,54 @@ pub(super) fn bit_requirement(
     found.map(str::to_owned)
 }
 
+/// The rule of the CMD 6 mask and value (4.1 CMD6): D0 has 0 at the bits to change.
+pub(super) const MASK_RULE: &str = "HPD-FRAME-017";
+
+/// The rule of the CMD 6 PAR (4.1 CMD6): the byte holding the bits, address + 1 for 8–15.
+pub(super) const BYTE_RULE: &str = "HPD-FRAME-018";
+
+/// The rule a bit change (CMD 6 at byte `offset` of the parameter, `mask` with 0 at the bits
+/// to change, `value` with their new state) breaks, judged by the device's response `got` to
+/// a read of the parameter right after it and the reference's `exp`; None when the change
+/// took or the bytes do not tell. Where the reference holds the written bits and the device
+/// does not: its mask and value were misread ([`MASK_RULE`]) when other bits of the byte
+/// differ too, else the change went to another byte ([`BYTE_RULE`]). Where the reference
+/// does not hold them (a command bit that clears itself, a drive gone silent): the device
+/// took PAR for the other byte of the word ([`BYTE_RULE`]) when that byte holds the written
+/// bits there and the reference's does not.
+pub(super) fn bit_change_broken(
+    rules: &FrameRules,
+    offset: usize,
+    mask: u8,
+    value: u8,
+    exp: &[u8],
+    got: &[u8],
+) -> Option<&'static str> {
+    let (_, dev) = response(rules, got)?;
+    let dev = dev.as_slice();
+    let d = *dev.get(offset)?;
+    let changed = !mask;
+    let want = value & changed;
+    if d & changed == want {
+        return None;
+    }
+    let reference = response(rules, exp).map(|(_, data)| data);
+    let at = |data: &[u8], k: usize| data.get(k).copied();
+    let image = offset ^ 1;
+    match reference.as_ref().and_then(|r| at(r.as_slice(), offset)) {
+        Some(r) if r & changed == want => Some(if (d ^ r) & mask != 0 {
+            MASK_RULE
+        } else {
+            BYTE_RULE
+        }),
+        _ => {
+            let di = at(dev, image)?;
+            let ri = reference.as_ref().and_then(|r| at(r.as_slice(), image));
+            (di & changed == want && ri.is_none_or(|ri| ri & changed != want)).then_some(BYTE_RULE)
+        }
+    }
+}
+
 /// The address and data of the response `bytes` hold, if they are one.
 fn response(rules: &FrameRules, bytes: &[u8]) -> Option<(u8, Data)> {
     match drivespec_hpd::parse(rules, bytes) {
@@ -114,6 +163,36 @@ mod tests {
             bit_requirement(family, None, par, &data(&[0x0E, 0]), &data(&[0x02, 0])),
             None
         );
+    }
+
+    fn answer(rules: &FrameRules, d: &[u8]) -> Vec<u8> {
+        Message::Response {
+            addr: 0,
+            par: 0x62,
+            data: data(d),
+        }
+        .to_bytes(rules)
+        .unwrap()
+    }
+
+    #[test]
+    fn a_bit_change_read_back_without_its_bits_names_mask_or_byte() {
+        let spec = Spec::builtin().unwrap();
+        let rules = FrameRules::from_spec(&spec).unwrap();
+        let r = |d: &[u8]| answer(&rules, d);
+        // Set bit 0 of the high byte (b70.8): mask FE, value 01, byte 1.
+        let set =
+            |exp: &[u8], got: &[u8]| bit_change_broken(&rules, 1, 0xFE, 0x01, &r(exp), &r(got));
+        assert_eq!(set(&[0x00, 0x01], &[0x00, 0x01]), None);
+        assert_eq!(set(&[0x00, 0x01], &[0x01, 0x00]), Some(BYTE_RULE));
+        assert_eq!(set(&[0x00, 0x01], &[0x00, 0xFF]), None);
+        assert_eq!(set(&[0x00, 0x01], &[0x00, 0xFE]), Some(MASK_RULE));
+        // A command bit the reference cleared at once: only the other byte tells.
+        assert_eq!(set(&[0x00, 0x00], &[0x00, 0x00]), None);
+        assert_eq!(set(&[0x00, 0x00], &[0x01, 0x00]), Some(BYTE_RULE));
+        // The reference went silent: the device's other byte holds the bits.
+        let silent = bit_change_broken(&rules, 1, 0xFE, 0x01, &[], &r(&[0x01, 0x00]));
+        assert_eq!(silent, Some(BYTE_RULE));
     }
 
     #[test]

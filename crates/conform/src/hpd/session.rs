@@ -30,7 +30,10 @@
 //! time-out less the slack. The first failing step ends the judged part of a case; its
 //! clean-up steps still run. On a transport that cannot reset the device, the reference is
 //! brought back in line after a failure by reading the parameters the case touched from the
-//! device.
+//! device. A case that fails after bit changes or applied inputs runs once more with each of
+//! them read back ([`verify`]), to name the requirement the failure broke.
+
+mod verify;
 
 use super::attribute::{self, Order};
 use super::motion::{self, Round, Sample};
@@ -88,6 +91,12 @@ pub struct HpdSession<'a, 's> {
     /// The byte orders the device's responses of this attempt showed against the
     /// reference's (right, reversed), read and save steps alike.
     orders: (bool, bool),
+    /// This run reads back the case's bit changes and inputs ([`verify`]).
+    verify: bool,
+    /// A read-back of this run showed a bit change or the inputs not taken.
+    read_back_failed: bool,
+    /// The transport failed in this attempt.
+    link_broke: bool,
 }
 
 /// Attempts of a case on real time while its timing stays undecided (the runner's own
@@ -181,6 +190,9 @@ impl<'a, 's> HpdSession<'a, 's> {
             missed: false,
             runner_late: false,
             orders: (false, false),
+            verify: false,
+            read_back_failed: false,
+            link_broke: false,
         };
         session.oracle = session.base();
         session
@@ -1234,7 +1246,7 @@ impl HpdSession<'_, '_> {
             self.undecided = None;
             self.missed = false;
             self.runner_late = false;
-            let mut run = self.attempt(info, case, from_start);
+            let run = self.attempt(info, case, from_start);
             if self.missed
                 && self.runner_late
                 && matches!(run.outcome, Outcome::Fail(_))
@@ -1255,6 +1267,7 @@ impl HpdSession<'_, '_> {
                 }
                 _ => {
                     self.last_attempt = true;
+                    let mut run = self.verified(info, case, run);
                     if let (false, Some(first)) = (why.is_empty(), run.evidence.first_mut()) {
                         let note = format!("undecided timing, not counted: {}", why.join("; "));
                         first.note = Some(match first.note.take() {
@@ -1323,6 +1336,7 @@ impl HpdSession<'_, '_> {
         self.saved.clear();
         self.split_from = None;
         self.orders = (false, false);
+        self.link_broke = false;
         // What a failure may cite: the case's own requirements first, as declared.
         let mut order: Vec<String> = case.checks.clone();
         for r in &info.requirements {
@@ -1720,6 +1734,7 @@ impl HpdSession<'_, '_> {
                         });
                     }
                     broken = true;
+                    self.link_broke = true;
                     match self.link.recover() {
                         Ok(Recovered::Fresh) => self.reset_oracle(),
                         Ok(Recovered::Same) => {}
@@ -1731,6 +1746,9 @@ impl HpdSession<'_, '_> {
             }
             self.note_order(&rec);
             evidence.push(rec);
+            if judged && failure.is_none() && !broken {
+                failure = self.read_back(i, step, &mut evidence);
+            }
         }
         if failure.is_some() && !broken && !caps.reset {
             self.resync(case);
