@@ -277,3 +277,50 @@ fn every_motion_mutant_fails_citing_its_requirement_first() {
     println!("HPD motion mutants:\n{}", report.join("\n"));
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// A case that fails after a set-up it relies on runs again with its bit changes and inputs
+/// read back: a bit change that landed in the other byte fails at its read-back naming the
+/// PAR rule of CMD 6 (4.1), inputs never read name the input rule (3.8.1); a passing device
+/// sees no read-back.
+#[test]
+fn a_set_up_that_did_not_take_fails_at_its_read_back() {
+    use drivespec_implementations::hpd_mutants::Kind;
+    for (kind, id, rule) in [
+        (
+            Kind::WrongBitChangeByte,
+            "hpd/plc/vector/plc-add-71-72-64",
+            "HPD-FRAME-018",
+        ),
+        (
+            Kind::DeafInputs,
+            "hpd/plc/vector/plc-ld-out",
+            "HPD-BIT-90-INPUTS",
+        ),
+    ] {
+        let run = run_one(kind, id);
+        let Outcome::Fail(f) = run.outcome else {
+            panic!("{kind:?} passes {id}");
+        };
+        assert_eq!(f.requirements[0].id, rule, "{id}: {f:?}");
+        let step = &run.evidence[f.step.unwrap()];
+        assert!(step.action.starts_with("read back"), "{id}: {step:?}");
+    }
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let drive = drivespec_hpd::model::Drive::new(
+        spec(),
+        drivespec_hpd::model::DriveConfig::commissioned(0),
+    )
+    .unwrap();
+    let mut session = suite.session(Box::new(SimLink::new("reference", Box::new(drive))));
+    let i = suite
+        .cases()
+        .iter()
+        .position(|c| c.id == "hpd/plc/vector/plc-ld-out")
+        .unwrap();
+    let run = session.run(i);
+    assert!(matches!(run.outcome, Outcome::Pass), "{:?}", run.outcome);
+    assert!(run
+        .evidence
+        .iter()
+        .all(|r| !r.action.starts_with("read back")));
+}

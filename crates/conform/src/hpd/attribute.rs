@@ -85,7 +85,7 @@ pub(super) fn bit_requirement(
 }
 
 /// The rule of the CMD 6 mask and value (4.1 CMD6): D0 has 0 at the bits to change.
-pub(super) const MASK_RULE: &str = "HPD-FRAME-017";
+const MASK_RULE: &str = "HPD-FRAME-017";
 
 /// The rule of the CMD 6 PAR (4.1 CMD6): the byte holding the bits, address + 1 for 8–15.
 pub(super) const BYTE_RULE: &str = "HPD-FRAME-018";

@@ -8,7 +8,7 @@
 
 use super::{HpdSession, ANSWER_TIME_REQUIREMENT, FORM, TIMEOUT_REQUIREMENT};
 use crate::case::{CaseInfo, CaseRun, Failure, Outcome, Record, RequirementRef, Role};
-use crate::hpd::attribute::{self, BYTE_RULE, MASK_RULE};
+use crate::hpd::attribute::{self, BYTE_RULE};
 use crate::hpd::step::{Action, HpdCase, Step};
 use crate::link::concat;
 use drivespec_hpd::Message;
@@ -116,7 +116,7 @@ impl HpdSession<'_, '_> {
             attribute::bit_change_broken(&self.suite.rules, offset, mask, value, &exp, &got);
         let changed = !mask;
         let why = format!(
-            "byte {par:#04x} bits {changed:#04x} should read {:#04x} after the bit change",
+            "the bit change wrote bits {changed:#04x} of byte {par:#04x} as {:#04x}",
             value & changed
         );
         self.judge_read_back(i, step, broken, why, &mut rec, evidence)
@@ -157,7 +157,7 @@ impl HpdSession<'_, '_> {
             (Some(e), Some(g)) if (e ^ g) & bits != 0 => input_rule(step),
             _ => None,
         };
-        let why = format!("the input bits {bits:#06x} should read as applied");
+        let why = format!("input bits {bits:#06x} as the inputs were applied");
         self.judge_read_back(i, step, broken, why, &mut rec, evidence)
     }
 
@@ -215,7 +215,7 @@ impl HpdSession<'_, '_> {
             Failure {
                 step: Some(evidence.len()),
                 message: format!(
-                    "step {i} ({}): not taken: {why}; {}: expected {}, got {}",
+                    "step {i} ({}) did not take: {why}; {}: expected {}, got {}",
                     step.text,
                     rec.action,
                     show(rec.expected.as_ref()),
