@@ -115,28 +115,15 @@ fn every_mutant_fails_exactly_cases_covering_its_broken_requirement() {
     assert_eq!(caught, all.len());
 }
 
-/// Mutants whose deviation hits a set-up step that no check verifies on its own (a bit
-/// change, the inputs, a watch's samples): the case that fails cites the behaviour its check
-/// evaluates first, and the broken requirement further down. Each must still show such a
-/// case; one whose failures all lead with a requirement it breaks is taken off.
-const LED_BY_ITS_EFFECT: [(&str, &str); 4] = [
-    (
-        "wrong bit-change byte",
-        "set-up bit changes of the high byte (b99.13, b90.8..15) are not read back",
-    ),
-    (
-        "digital inputs never read",
-        "the inputs applied before a PLC vector are not read back from b90.0..b90.7",
-    ),
-    (
-        "big-endian data",
-        "a watch judges the values of its samples, not their byte order",
-    ),
-    (
-        "b99.3 set for non-zero results",
-        "vectors whose first requirement is another instruction's read b99.3 with the rest of Pb99",
-    ),
-];
+/// Mutants whose deviation leaves no trace on any byte the suite can read: the case that
+/// fails cites the behaviour its check evaluates first, and the broken requirement further
+/// down. Each must still show such a case; one whose failures all lead with a requirement it
+/// breaks is taken off.
+const LED_BY_ITS_EFFECT: [(&str, &str); 1] = [(
+    "wrong bit-change byte",
+    "a bit change of the self-clearing command bit b99.11 lands on b99.3, a bit the drive computes itself: \
+     read back, Pb99 is the reference's, and only the missing effect of the command shows",
+)];
 
 /// What a CI log shows first for a failure: the broken requirement, then what went wrong,
 /// what the manual allows and what came.
@@ -289,4 +276,51 @@ fn every_motion_mutant_fails_citing_its_requirement_first() {
     }
     println!("HPD motion mutants:\n{}", report.join("\n"));
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// A case that fails after a set-up it relies on runs again with its bit changes and inputs
+/// read back: a bit change that landed in the other byte fails at its read-back naming the
+/// PAR rule of CMD 6 (4.1), inputs never read name the input rule (3.8.1); a passing device
+/// sees no read-back.
+#[test]
+fn a_set_up_that_did_not_take_fails_at_its_read_back() {
+    use drivespec_implementations::hpd_mutants::Kind;
+    for (kind, id, rule) in [
+        (
+            Kind::WrongBitChangeByte,
+            "hpd/plc/vector/plc-add-71-72-64",
+            "HPD-FRAME-018",
+        ),
+        (
+            Kind::DeafInputs,
+            "hpd/plc/vector/plc-ld-out",
+            "HPD-BIT-90-INPUTS",
+        ),
+    ] {
+        let run = run_one(kind, id);
+        let Outcome::Fail(f) = run.outcome else {
+            panic!("{kind:?} passes {id}");
+        };
+        assert_eq!(f.requirements[0].id, rule, "{id}: {f:?}");
+        let step = &run.evidence[f.step.unwrap()];
+        assert!(step.action.starts_with("read back"), "{id}: {step:?}");
+    }
+    let suite = HpdSuite::new(spec(), &Settings::default()).unwrap();
+    let drive = drivespec_hpd::model::Drive::new(
+        spec(),
+        drivespec_hpd::model::DriveConfig::commissioned(0),
+    )
+    .unwrap();
+    let mut session = suite.session(Box::new(SimLink::new("reference", Box::new(drive))));
+    let i = suite
+        .cases()
+        .iter()
+        .position(|c| c.id == "hpd/plc/vector/plc-ld-out")
+        .unwrap();
+    let run = session.run(i);
+    assert!(matches!(run.outcome, Outcome::Pass), "{:?}", run.outcome);
+    assert!(run
+        .evidence
+        .iter()
+        .all(|r| !r.action.starts_with("read back")));
 }

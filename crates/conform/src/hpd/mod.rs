@@ -16,6 +16,7 @@
 //! | `vector` | the spec's `hpd-frame` vectors, at their drive address |
 //! | `motion` | the motor turned by jog, the speed reference and the mode 9 profile, judged by envelopes; the wiring test |
 
+mod attribute;
 mod behaviour;
 pub mod cases;
 pub mod frame;

@@ -30,8 +30,12 @@
 //! time-out less the slack. The first failing step ends the judged part of a case; its
 //! clean-up steps still run. On a transport that cannot reset the device, the reference is
 //! brought back in line after a failure by reading the parameters the case touched from the
-//! device.
+//! device. A case that fails after bit changes or applied inputs runs once more with each of
+//! them read back ([`verify`]), to name the requirement the failure broke.
 
+mod verify;
+
+use super::attribute::{self, Order};
 use super::motion::{self, Round, Sample};
 use super::readings::{Bases, Journal, Judge};
 use super::step::{Action, Compare, HpdCase, Step};
@@ -84,6 +88,15 @@ pub struct HpdSession<'a, 's> {
     missed: bool,
     /// The runner woke later than [`RUNNER_ON_TIME_US`] from a short wait of this attempt.
     runner_late: bool,
+    /// The byte orders the device's responses of this attempt showed against the
+    /// reference's (right, reversed), read and save steps alike.
+    orders: (bool, bool),
+    /// This run reads back the case's bit changes and inputs ([`verify`]).
+    verify: bool,
+    /// A read-back of this run showed a bit change or the inputs not taken.
+    read_back_failed: bool,
+    /// The transport failed in this attempt.
+    link_broke: bool,
 }
 
 /// Attempts of a case on real time while its timing stays undecided (the runner's own
@@ -176,6 +189,10 @@ impl<'a, 's> HpdSession<'a, 's> {
             undecided: None,
             missed: false,
             runner_late: false,
+            orders: (false, false),
+            verify: false,
+            read_back_failed: false,
+            link_broke: false,
         };
         session.oracle = session.base();
         session
@@ -834,10 +851,13 @@ impl<'a, 's> HpdSession<'a, 's> {
     /// The requirement a failing exchange breaks, by what differs between the reference's
     /// answer `expected` and the device's `got` (manual 4.1): the checksum or stuffing of an
     /// answer that does not decode; the answering address, LUN and PAR, or byte order of a
-    /// response; the form of an acknowledge; an answer to a broadcast. A response of the
-    /// right form with another value keeps every rule of the message form: it breaks the
-    /// behaviour the step or case checks, its first requirement outside [`FORM`]. None when
-    /// the bytes tell nothing (silence, or an answer where the reference is silent).
+    /// response (reversed data, unless the device answered in the right order before in the
+    /// case); the form of an acknowledge; an answer to a broadcast. A response of the right
+    /// form with another value keeps every rule of the message form: it breaks the rule of
+    /// the bits it differs in when their rules name one requirement
+    /// ([`attribute::bit_requirement`]), else the behaviour the step or case checks, its
+    /// first requirement outside [`FORM`]. None when the bytes tell nothing (silence, or an
+    /// answer where the reference is silent).
     fn broken(
         &self,
         expected: &[u8],
@@ -874,8 +894,15 @@ impl<'a, 's> HpdSession<'a, 's> {
                     "HPD-FRAME-010"
                 } else if p != q || d.len() != x.len() {
                     "HPD-SERIAL-017"
-                } else if d.len() > 1 && x.as_slice().iter().rev().eq(d.as_slice()) {
-                    "HPD-SERIAL-016"
+                } else if d.len() > 1
+                    && !self.orders.0
+                    && x.as_slice().iter().rev().eq(d.as_slice())
+                {
+                    BYTE_ORDER
+                } else if let Some(r) =
+                    attribute::bit_requirement(self.suite.family(), self.mode(), p, &d, &x)
+                {
+                    return Some(r);
                 } else {
                     return own
                         .iter()
@@ -928,6 +955,49 @@ impl<'a, 's> HpdSession<'a, 's> {
             .filter_map(|id| RequirementRef::of(family, &id))
             .collect()
     }
+
+    /// The operating mode the reference is in (manual 3.6, Pr31).
+    fn mode(&self) -> Option<u32> {
+        let family = self.suite.family();
+        let p = family.parameter(&self.suite.protocol().commands.mode_param)?;
+        let addr = u8::try_from(p.address?).ok()?;
+        let size = u8::try_from(p.size?).ok()?;
+        Some(self.oracle.memory().get(addr, size))
+    }
+
+    /// Notes the byte order the response of `rec` showed against the reference's.
+    fn note_order(&mut self, rec: &Record) {
+        let bytes = |a: Option<&Answer>| {
+            a.and_then(|a| drivespec_spec::hex::parse_hex(&a.hex).ok())
+                .unwrap_or_default()
+        };
+        let exp = bytes(rec.expected.as_ref());
+        let got = bytes(rec.got.as_ref());
+        match attribute::byte_order(&self.suite.rules, &exp, &got) {
+            Some(Order::Right) => self.orders.0 = true,
+            Some(Order::Reversed) => self.orders.1 = true,
+            None => {}
+        }
+    }
+
+    /// Puts the byte-order rule first in a failure led by a behaviour (a rule outside the
+    /// message form and the answer time) when the device answered the reference's data
+    /// reversed before in the case and never in the right order: the values it was given
+    /// back, or read, are byte-swapped, and the behaviour fails on them.
+    fn lead_by_byte_order(&self, requirements: &mut Vec<RequirementRef>) {
+        let led_by_behaviour = requirements.first().is_some_and(|r| {
+            !FORM.contains(&r.id.as_str())
+                && r.id != ANSWER_TIME_REQUIREMENT
+                && r.id != TIMEOUT_REQUIREMENT
+        });
+        if !(led_by_behaviour && self.orders.1 && !self.orders.0) {
+            return;
+        }
+        if let Some(r) = RequirementRef::of(self.suite.family(), BYTE_ORDER) {
+            requirements.retain(|x| x.id != r.id);
+            requirements.insert(0, r);
+        }
+    }
 }
 
 /// The rules of a read and of an answer's form (manual 4.1), which a response with the right
@@ -952,6 +1022,9 @@ const FORM: &[&str] = &[
     "HPD-SERIAL-016",
     "HPD-SERIAL-017",
 ];
+
+/// The rule that multi-byte data travel least significant byte first (4.1 cases 2 and 4).
+const BYTE_ORDER: &str = "HPD-SERIAL-016";
 
 /// The rule that no drive answers a broadcast (4.1 notes; CMD 7).
 const BROADCAST_SILENT: &str = "HPD-SERIAL-013";
@@ -1173,7 +1246,7 @@ impl HpdSession<'_, '_> {
             self.undecided = None;
             self.missed = false;
             self.runner_late = false;
-            let mut run = self.attempt(info, case, from_start);
+            let run = self.attempt(info, case, from_start);
             if self.missed
                 && self.runner_late
                 && matches!(run.outcome, Outcome::Fail(_))
@@ -1194,6 +1267,7 @@ impl HpdSession<'_, '_> {
                 }
                 _ => {
                     self.last_attempt = true;
+                    let mut run = self.verified(info, case, run);
                     if let (false, Some(first)) = (why.is_empty(), run.evidence.first_mut()) {
                         let note = format!("undecided timing, not counted: {}", why.join("; "));
                         first.note = Some(match first.note.take() {
@@ -1261,6 +1335,8 @@ impl HpdSession<'_, '_> {
         }
         self.saved.clear();
         self.split_from = None;
+        self.orders = (false, false);
+        self.link_broke = false;
         // What a failure may cite: the case's own requirements first, as declared.
         let mut order: Vec<String> = case.checks.clone();
         for r in &info.requirements {
@@ -1618,6 +1694,7 @@ impl HpdSession<'_, '_> {
                                 requirements.retain(|x| x.id != r.id);
                                 requirements.insert(0, r);
                             }
+                            self.lead_by_byte_order(&mut requirements);
                             failure = Some(Failure {
                                 step: Some(evidence.len()),
                                 message: format!("step {i} ({}): {why}", step.text),
@@ -1657,6 +1734,7 @@ impl HpdSession<'_, '_> {
                         });
                     }
                     broken = true;
+                    self.link_broke = true;
                     match self.link.recover() {
                         Ok(Recovered::Fresh) => self.reset_oracle(),
                         Ok(Recovered::Same) => {}
@@ -1666,7 +1744,11 @@ impl HpdSession<'_, '_> {
                     }
                 }
             }
+            self.note_order(&rec);
             evidence.push(rec);
+            if judged && failure.is_none() && !broken {
+                failure = self.read_back(i, step, &mut evidence);
+            }
         }
         if failure.is_some() && !broken && !caps.reset {
             self.resync(case);
