@@ -323,6 +323,12 @@ pub trait CyclicFamily<'s> {
     fn ramp_requirements(&self) -> Option<[&'static str; 2]> {
         None
     }
+    /// The requirement stating the sign of the speed in the input image, which a device
+    /// breaks when its speed's sign differs from the reference's while its position moves
+    /// the same way. By default none.
+    fn speed_sign_requirement(&self) -> Option<&'static str> {
+        None
+    }
 }
 
 /// How much steeper than the reference's steepest speed change per cycle a device's may be,
@@ -492,6 +498,9 @@ struct Finding {
     what: String,
     /// The requirements the violation breaks, most specific first (cited before the case's).
     breaks: Vec<String>,
+    /// Whether `breaks` leads even in a case that checks one requirement: the check found a
+    /// change the other side does not make at all, or a ramp or sign the images show alone.
+    own: bool,
 }
 
 impl Finding {
@@ -502,6 +511,7 @@ impl Finding {
             reference,
             what,
             breaks: Vec::new(),
+            own: false,
         }
     }
 
@@ -509,7 +519,16 @@ impl Finding {
         self.breaks = breaks;
         self
     }
+
+    fn leading(mut self, own: bool) -> Finding {
+        self.own = own;
+        self
+    }
 }
+
+/// Cycles after a change of the speed's sign within which the position shows the way the
+/// shaft turns: the first cycle of a run may not move it by a whole increment yet.
+const TRAVEL_CYCLES: usize = 20;
 
 /// Cycles whose sample a comparison of changes passes over, per side (by cycle index).
 #[derive(Clone, Copy)]
@@ -1239,6 +1258,18 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             let segment = run.cycles.get(from..to).unwrap_or(&[]);
             let before = from.checked_sub(1).and_then(|i| run.cycles.get(i));
             let open_bits = run.open.as_ref().map_or(0, |o| o.bits);
+            // Whether the speed's sign is the same on both sides over the cycles up to `at`.
+            let moves_alike = |at: usize| {
+                run.cycles
+                    .get(at.saturating_sub(TRAVEL_CYCLES)..=at)
+                    .is_some_and(|cs| {
+                        cs.iter().all(|c| {
+                            c.dut.as_ref().is_ok_and(|d| {
+                                F::motion(d).1.signum() == F::motion(&c.reference).1.signum()
+                            })
+                        })
+                    })
+            };
             for bit in (0..16u16).filter(|b| open_bits & (1 << b) == 0) {
                 let mask = 1u16 << bit;
                 let what = |v: Option<bool>| match v {
@@ -1279,7 +1310,16 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                             what(x.reference),
                             step_of(&run.cycles, x.theirs)
                         ),
-                    ).breaking(self.bit_rules(bit, x.reference.or(x.device))));
+                    )
+                    .breaking(self.bit_rules(bit, x.reference.or(x.device)))
+                    // One side makes a change the other does not make at all while both
+                    // move alike: the bit's own rule. Where the motion differs too, the bit
+                    // follows it and the case's requirements lead.
+                    .leading(
+                        mask != running
+                            && x.device.is_none() != x.reference.is_none()
+                            && moves_alike(x.at),
+                    ));
                 }
             }
             let word = |v: Option<i64>| match v {
@@ -1299,19 +1339,54 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             )
             .filter(|x| !(movement_open || late(x.device.is_none(), x.theirs)))
             {
-                bad.push(Finding::at(
-                    x.at,
-                    run.cycles.get(x.at).map_or(0, |c| c.step),
-                    x.theirs,
-                    format!(
-                        "movement {}: {} on the device{}, {} on the reference{}",
-                        x.change,
-                        word(x.device),
-                        step_of(&run.cycles, Some(x.at)),
-                        word(x.reference),
-                        step_of(&run.cycles, x.theirs)
-                    ),
-                ));
+                // The position moving the reference's way while the speed says otherwise:
+                // the speed's sign is wrong, not the run.
+                let travel = |dut: bool| {
+                    let at = |i: usize| {
+                        run.cycles.get(i).and_then(|c| {
+                            if dut {
+                                c.dut.as_ref().ok().map(|d| F::motion(d).0)
+                            } else {
+                                Some(F::motion(&c.reference).0)
+                            }
+                        })
+                    };
+                    let from = if dut { x.at } else { x.theirs.unwrap_or(x.at) };
+                    let start = from.checked_sub(1).and_then(at);
+                    (from..from.saturating_add(TRAVEL_CYCLES))
+                        .find_map(|i| {
+                            let d = at(i)?.saturating_sub(start?).signum();
+                            (d != 0).then_some(d)
+                        })
+                        .unwrap_or(0)
+                };
+                let sign_only = x.device.is_some()
+                    && x.reference.is_some()
+                    && travel(true) != 0
+                    && travel(true) == travel(false);
+                let sign = self
+                    .family
+                    .speed_sign_requirement()
+                    .filter(|_| sign_only)
+                    .map(|r| vec![r.to_owned()])
+                    .unwrap_or_default();
+                bad.push(
+                    Finding::at(
+                        x.at,
+                        run.cycles.get(x.at).map_or(0, |c| c.step),
+                        x.theirs,
+                        format!(
+                            "movement {}: {} on the device{}, {} on the reference{}",
+                            x.change,
+                            word(x.device),
+                            step_of(&run.cycles, Some(x.at)),
+                            word(x.reference),
+                            step_of(&run.cycles, x.theirs)
+                        ),
+                    )
+                    .leading(!sign.is_empty())
+                    .breaking(sign),
+                );
             }
             if let Some(x) = first_difference(
                 before,
@@ -1333,6 +1408,46 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         step_of(&run.cycles, Some(x.at))
                     ),
                 ));
+            }
+        }
+        // The ramps: no speed change per cycle steeper than the reference's plus slack (ahead
+        // of the speed bound: a steep ramp explains a speed too high in the same cycle).
+        if let Some([accel, decel]) = self.family.ramp_requirements() {
+            let (up, down, _, _) = steepest(
+                run.cycles
+                    .iter()
+                    .map(|c| Some((F::motion(&c.reference).1, c.t, c.t))),
+            );
+            let (dev_up, dev_down, up_at, down_at) = steepest(
+                run.cycles
+                    .iter()
+                    .map(|c| c.dut.as_ref().ok().map(|d| (F::motion(d).1, c.t, c.taken))),
+            );
+            let bound = |r: i64| {
+                r.saturating_mul(100 + RAMP_SLACK_PERCENT)
+                    .saturating_div(100)
+                    .saturating_add(2 * tol.speed)
+            };
+            for (what, req, theirs, mine, at) in [
+                ("speeds up", accel, up, dev_up, up_at),
+                ("slows down", decel, down, dev_down, down_at),
+            ] {
+                if let Some(i) = at.filter(|_| theirs > 0 && mine > bound(theirs)) {
+                    bad.push(
+                        Finding::at(
+                            i,
+                            run.cycles.get(i).map_or(0, |c| c.step),
+                            None,
+                            format!(
+                                "the speed {what} by {mine} rpm in one cycle; at most {} rpm (the steepest in force, {theirs} rpm, plus {RAMP_SLACK_PERCENT} % and {} rpm)",
+                                bound(theirs),
+                                2 * tol.speed
+                            ),
+                        )
+                        .breaking(vec![req.to_owned()])
+                        .leading(true),
+                    );
+                }
             }
         }
         // The speed: never above the reference's highest, and as high where it cruises.
@@ -1373,44 +1488,6 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 None,
                 format!("the highest speed is {v} rpm; the speed in force is {top} rpm (at least {floor} rpm)"),
             ));
-        }
-        // The ramps: no speed change per cycle steeper than the reference's plus slack.
-        if let Some([accel, decel]) = self.family.ramp_requirements() {
-            let (up, down, _, _) = steepest(
-                run.cycles
-                    .iter()
-                    .map(|c| Some((F::motion(&c.reference).1, c.t, c.t))),
-            );
-            let (dev_up, dev_down, up_at, down_at) = steepest(
-                run.cycles
-                    .iter()
-                    .map(|c| c.dut.as_ref().ok().map(|d| (F::motion(d).1, c.t, c.taken))),
-            );
-            let bound = |r: i64| {
-                r.saturating_mul(100 + RAMP_SLACK_PERCENT)
-                    .saturating_div(100)
-                    .saturating_add(2 * tol.speed)
-            };
-            for (what, req, theirs, mine, at) in [
-                ("speeds up", accel, up, dev_up, up_at),
-                ("slows down", decel, down, dev_down, down_at),
-            ] {
-                if let Some(i) = at.filter(|_| theirs > 0 && mine > bound(theirs)) {
-                    bad.push(
-                        Finding::at(
-                            i,
-                            run.cycles.get(i).map_or(0, |c| c.step),
-                            None,
-                            format!(
-                                "the speed {what} by {mine} rpm in one cycle; at most {} rpm (the steepest in force, {theirs} rpm, plus {RAMP_SLACK_PERCENT} % and {} rpm)",
-                                bound(theirs),
-                                2 * tol.speed
-                            ),
-                        )
-                        .breaking(vec![req.to_owned()]),
-                    );
-                }
-            }
         }
         // Settled on both sides: exact parts equal, positions within the tolerance.
         let cycle_us = self.family.cycle_us();
@@ -1463,10 +1540,11 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         .reference
                         .and_then(|t| run.cycles.get(t))
                         .map_or(&c.reference, |r| &r.reference);
-                    // A case that checks one requirement names it first: what it finds
-                    // breaks that requirement; the status bit's own rules follow.
+                    // A case that checks one requirement names it first (what it finds
+                    // breaks that requirement; the status bit's own rules follow), unless
+                    // the finding is the check's own (`Finding::own`).
                     let mut reqs: Vec<String> = match run.reqs {
-                        [only] => vec![only.clone()],
+                        [only] if !f.own => vec![only.clone()],
                         _ => Vec::new(),
                     };
                     for r in f.breaks.iter().chain(run.reqs) {

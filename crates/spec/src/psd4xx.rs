@@ -341,6 +341,8 @@ pub struct PkwCommand {
     pub positive: Vec<u8>,
     /// Response codes on failure.
     pub negative: Vec<u8>,
+    /// The requirement the code of the drive's answer states.
+    pub requirement: String,
     /// Manual section (and erratum where the table was reconstructed).
     pub source: String,
 }
@@ -371,6 +373,8 @@ pub struct PkwError {
     pub name: String,
     /// The meaning, in our words.
     pub meaning: String,
+    /// The requirement that a situation gives this error.
+    pub requirement: String,
     /// Manual section.
     pub source: String,
 }
@@ -387,6 +391,8 @@ pub struct EchoRule {
     pub response_as_read: bool,
     /// Fields copied unchanged from the command (`pnu`, `ind`, `pwe`).
     pub copied: Vec<String>,
+    /// The requirement that the copied fields equal the command's.
+    pub requirement: String,
 }
 
 /// A string parameter read through PKW in fixed segments (3.3 par. 13).
@@ -449,6 +455,8 @@ pub struct RecordLength {
     pub read: usize,
     /// Bytes of a write request (control byte + value).
     pub write: usize,
+    /// The requirement stating the read length.
+    pub read_requirement: String,
 }
 
 /// What the drive does with the controller's outputs in one situation (3.9).

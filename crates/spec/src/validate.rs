@@ -1,7 +1,7 @@
 //! Consistency rules over a loaded spec (see `spec/SCHEMA.md`, "The loader rejects …").
 
 use crate::error::{Problem, ProblemKind};
-use crate::{Family, Level, Parameter, Spec};
+use crate::{Family, Level, Parameter, Protocol, Spec};
 use std::collections::BTreeMap;
 
 /// Every rule violated by the spec, in family and file order.
@@ -21,6 +21,7 @@ pub(crate) fn validate(spec: &Spec) -> Vec<Problem> {
         v.errata();
         v.vectors();
         v.scenarios();
+        v.access_requirements();
     }
     problems
 }
@@ -506,6 +507,44 @@ impl Validator<'_> {
                 let message = "a scenario needs at least one step".to_owned();
                 self.push(&s.file, rec.clone(), ProblemKind::Invalid { message });
             }
+        }
+    }
+
+    /// The requirements the PKW and record tables name (3.8, 3.2.2): each answer code, error
+    /// code, the echo rule and each record read length states one.
+    fn access_requirements(&mut self) {
+        let f = self.family;
+        let Protocol::Psd4xx(p) = &f.protocol else {
+            return;
+        };
+        let file = format!("{}/protocol.toml", f.id());
+        let named = p
+            .pkw
+            .commands
+            .iter()
+            .map(|c| (format!("pkw command {}", c.code), &c.requirement))
+            .chain(
+                p.pkw
+                    .errors
+                    .iter()
+                    .map(|e| (format!("pkw error {}", e.code), &e.requirement)),
+            )
+            .chain(std::iter::once((
+                "pkw echo".to_owned(),
+                &p.pkw.echo.requirement,
+            )))
+            .chain(
+                p.record
+                    .lengths
+                    .iter()
+                    .map(|l| (format!("record length {}", l.bits), &l.read_requirement)),
+            );
+        let dangling: Vec<(String, String)> = named
+            .filter(|(_, r)| f.requirement(r).is_none())
+            .map(|(rec, r)| (rec, r.clone()))
+            .collect();
+        for (rec, r) in dangling {
+            self.dangling(&file, rec, "requirement", &r);
         }
     }
 

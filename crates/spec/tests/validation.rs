@@ -6,17 +6,41 @@
     clippy::panic
 )]
 
-use drivespec_spec::{Spec, SpecFiles};
+use drivespec_spec::{FamilyId, Protocol, Spec, SpecFiles};
 
-/// The built-in family and protocol files, with no records.
+/// The built-in family and protocol files, with no records but the requirements the
+/// PSD4xx protocol tables name (PKW answers and errors, the echo, record read lengths).
 fn skeleton() -> SpecFiles {
     let builtin = SpecFiles::builtin();
-    SpecFiles::from_pairs(
+    let mut files = SpecFiles::from_pairs(
         builtin
             .iter()
             .filter(|(p, _)| p.ends_with("/family.toml") || p.ends_with("/protocol.toml"))
             .map(|(p, c)| (p.to_owned(), c.to_owned())),
-    )
+    );
+    files.set("psd4xx/requirements-access.toml", &access_requirements());
+    files
+}
+
+/// A requirement record for each ID the built-in PSD4xx protocol tables name.
+fn access_requirements() -> String {
+    let spec = Spec::builtin().unwrap();
+    let family = spec.family(FamilyId::Psd4xx);
+    let Protocol::Psd4xx(p) = &family.protocol else {
+        panic!("the PSD4xx family has the PSD4xx protocol");
+    };
+    let ids = p
+        .pkw
+        .commands
+        .iter()
+        .map(|c| &c.requirement)
+        .chain(p.pkw.errors.iter().map(|e| &e.requirement))
+        .chain(std::iter::once(&p.pkw.echo.requirement))
+        .chain(p.record.lengths.iter().map(|l| &l.read_requirement));
+    ids.map(|id| {
+        format!("[[requirement]]\nid = {id:?}\nlevel = \"must\"\ntext = \"named by the PKW and record tables\"\nsource = \"3.8\"\n\n")
+    })
+    .collect()
 }
 
 const PARAM: &str = r#"

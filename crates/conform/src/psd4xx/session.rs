@@ -9,6 +9,7 @@ use crate::cyclic_session::{env_op, same_length, CyclicFamily, CyclicSession, Op
 use drivespec_psd4xx::pkw::Reply as PkwReply;
 use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::{Input, Output, PkwRequest, PkwResponse};
+use drivespec_spec::psd4xx::{PkwOp, PkwValue};
 use drivespec_spec::{DataType, Family, FamilyId, Protocol};
 
 /// The value of one process-data field of an input image.
@@ -79,6 +80,53 @@ impl<'a, 's> Psd4xx<'a, 's> {
         };
         let save = save_ms.saturating_mul(1000).div_ceil(CYCLE_US);
         PKW_MAX_CYCLES.saturating_add(u32::try_from(save).unwrap_or(u32::MAX))
+    }
+
+    /// The requirement the device's PKW answer `got` to `command` breaks where it differs
+    /// from the reference's `want`, as the codes show (3.8, spec `pkw`): the answer to "no
+    /// command" (where the reference shows "no response"); the error the situation gives when the reference refuses; the answer code of
+    /// the command; the echo of a write. None when only the value differs (the parameter's
+    /// own requirement, the case's, applies).
+    fn pkw_broken(
+        &self,
+        command: &PkwRequest,
+        got: &PkwResponse,
+        want: &PkwResponse,
+    ) -> Option<&'s str> {
+        let Protocol::Psd4xx(p) = &self.suite.family().protocol else {
+            return None;
+        };
+        let pkw = &p.pkw;
+        let code = u8::from(command.ak);
+        let info = pkw.commands.iter().find(|c| c.code == code)?;
+        let (got_ak, want_ak) = (u8::from(got.ak), u8::from(want.ak));
+        let answer = |ak: u8, value: PkwValue| {
+            pkw.responses
+                .iter()
+                .any(|r| r.code == ak && r.value == value)
+        };
+        // "No command" is answered with "no response": where the reference shows it, the
+        // device shows something else.
+        if info.op == PkwOp::None || answer(want_ak, PkwValue::None) {
+            return pkw
+                .commands
+                .iter()
+                .find(|c| c.op == PkwOp::None)
+                .map(|c| c.requirement.as_str());
+        }
+        let refused = |ak: u8| answer(ak, PkwValue::Error);
+        if refused(want_ak) {
+            return pkw
+                .errors
+                .iter()
+                .find(|e| u32::from(e.code) == want.pwe)
+                .map(|e| e.requirement.as_str());
+        }
+        if got_ak != want_ak {
+            return Some(&info.requirement);
+        }
+        let echoed = (got.pnu, got.ind, got.pwe) == (command.pnu, command.ind, command.pwe);
+        (pkw.echo.commands.contains(&code) && !echoed).then_some(pkw.echo.requirement.as_str())
     }
 }
 
@@ -211,27 +259,53 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
         Some(["PSD-VEL-003", "PSD-VEL-004"])
     }
 
-    /// The case's requirements plus those of what differs in a cycle: the PKW handshake
-    /// rules (3.6: response held, value of the moment, command 0 answered with 0, one command
-    /// at a time) when the PKW block differs, the speed (par. 2) and position (par. 3) rules
-    /// when those differ, and the set/reset rules of every status bit that differs (spec
-    /// bitfield `status`).
+    /// Par. 2, the actual speed, signed (3.3).
+    fn speed_sign_requirement(&self) -> Option<&'static str> {
+        Some("PSD-PAR-2-001")
+    }
+
+    /// The requirements of what differs in a cycle: first the one the PKW answer breaks as
+    /// its codes show ([`Psd4xx::pkw_broken`]), then the case's, then the PKW handshake rules
+    /// (3.8: response held, value of the moment, command 0 answered with 0, one command at a
+    /// time) when the PKW block differs, the speed (par. 2) and position (par. 3) rules when
+    /// those differ, and the set/reset rules of every status bit that differs (spec bitfield
+    /// `status`).
     fn cited(
         &self,
         case: &[String],
-        _out: &Output,
+        out: &Output,
         dut: Option<&Input>,
         reference: &Input,
     ) -> Vec<String> {
-        let mut ids = case.to_vec();
+        let Some(d) = dut else {
+            return case.to_vec();
+        };
+        let mut ids: Vec<String> = Vec::new();
         let mut add = |id: &str| {
             if !ids.iter().any(|x| x == id) {
                 ids.push(id.to_owned());
             }
         };
-        let Some(d) = dut else {
-            return ids;
-        };
+        if d.pkw != reference.pkw {
+            match self.pkw_broken(&out.pkw, &d.pkw, &reference.pkw) {
+                Some(id) => add(id),
+                // Only the value differs: the requirement of the parameter answered.
+                None => {
+                    let pnu = reference.pkw.pnu.to_string();
+                    let family = self.suite.family();
+                    if let Some(id) = case.iter().find(|id| {
+                        family
+                            .requirement(id)
+                            .is_some_and(|r| r.params.iter().any(|p| *p == pnu))
+                    }) {
+                        add(id);
+                    }
+                }
+            }
+        }
+        for id in case {
+            add(id);
+        }
         if d.pkw != reference.pkw {
             for id in ["PSD-PKW-003", "PSD-PKW-004", "PSD-PKW-006", "PSD-PKW-007"] {
                 add(id);
@@ -253,6 +327,38 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
                 for rule in &b.rules {
                     add(&rule.requirement);
                 }
+            }
+        }
+        ids
+    }
+
+    /// A record read answered with another number of bytes than the reference's breaks the
+    /// read length of the reference's width (3.2.2, spec `record.length`) first.
+    fn reply_cited(
+        &self,
+        case: &[String],
+        req: &Request,
+        expected: &Reply,
+        got: &Reply,
+    ) -> Vec<String> {
+        let length = match (req, expected, got) {
+            (Request::Read { .. }, Reply::Data(e), Reply::Data(g)) if e.len() != g.len() => {
+                match &self.suite.family().protocol {
+                    Protocol::Psd4xx(p) => p
+                        .record
+                        .lengths
+                        .iter()
+                        .find(|l| l.read == e.len())
+                        .map(|l| l.read_requirement.clone()),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        let mut ids: Vec<String> = length.into_iter().collect();
+        for c in case {
+            if !ids.contains(c) {
+                ids.push(c.clone());
             }
         }
         ids
