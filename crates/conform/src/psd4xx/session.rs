@@ -296,7 +296,7 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
                     if let Some(id) = case.iter().find(|id| {
                         family
                             .requirement(id)
-                            .is_some_and(|r| r.params.iter().any(|p| *p == pnu))
+                            .is_some_and(|r| r.params.contains(&pnu))
                     }) {
                         add(id);
                     }
