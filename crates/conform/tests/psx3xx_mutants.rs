@@ -180,3 +180,15 @@ fn live_positions_read_by_isdu_are_judged_by_the_devices_own_process_data() {
     let exact = session.run(index("psx3xx/isdu/read/67"));
     assert!(exact.outcome.failed());
 }
+
+/// A refusal situation's requirement is what a failure cites first when a device answers
+/// otherwise: each names a requirement of the spec (a missing one would be dropped).
+#[test]
+fn every_refusal_situation_names_a_requirement_of_the_spec() {
+    let family = spec().family(drivespec_spec::FamilyId::Psx3xx);
+    let errors = &family.psx3xx().unwrap().isdu_errors;
+    for c in &errors.cases {
+        let id = c.requirement.as_deref().unwrap();
+        assert!(family.requirement(id).is_some(), "{}: {id}", c.case);
+    }
+}

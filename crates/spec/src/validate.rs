@@ -452,17 +452,6 @@ impl Validator<'_> {
                 self.push(&r.file, rec.clone(), ProblemKind::Invalid { message });
             }
         }
-        if let Some(p) = f.psx3xx() {
-            let file = format!("{}/protocol.toml", f.id().as_str());
-            for c in &p.isdu_errors.cases {
-                let rec = format!("protocol.isdu_errors.case {:?}", c.case);
-                if let Some(id) = c.requirement.as_deref() {
-                    if f.requirement(id).is_none() {
-                        self.dangling(&file, rec, "requirement", id);
-                    }
-                }
-            }
-        }
     }
 
     fn errata(&mut self) {
