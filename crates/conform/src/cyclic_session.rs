@@ -258,6 +258,18 @@ pub trait CyclicFamily<'s> {
         dut: Option<&Self::Input>,
         reference: &Self::Input,
     ) -> Vec<String>;
+    /// The requirements a failure of a motion case's judgement cites (`reqs`: what the
+    /// judgement found, then the case's), the one the device broke first, where the device's
+    /// image of the failing cycle differs from the reference's: by default [`Self::cited`].
+    fn judged_cited(
+        &self,
+        reqs: &[String],
+        out: &Self::Output,
+        dut: Option<&Self::Input>,
+        reference: &Self::Input,
+    ) -> Vec<String> {
+        self.cited(reqs, out, dut, reference)
+    }
     /// The requirements a differing reply to `req` cites, the one the device broke first
     /// (what the reply shows), then the case's (`case`, declared order).
     fn reply_cited(
@@ -1181,7 +1193,10 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     tol.cycles, tol.position, tol.speed
                 );
                 run.failed_cycle = Some(i);
-                run.failure = Some(self.cycle_failure(run.reqs, i, c, &c.reference, what));
+                let reqs = self
+                    .family
+                    .cited(run.reqs, &c.out, c.dut.as_ref().ok(), &c.reference);
+                run.failure = Some(self.cycle_failure(&reqs, i, c, &c.reference, what));
             }
         }
         bad_steps
@@ -1553,6 +1568,9 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         }
                     }
                     run.failed_cycle = Some(f.cycle);
+                    let reqs =
+                        self.family
+                            .judged_cited(&reqs, &c.out, c.dut.as_ref().ok(), reference);
                     run.failure =
                         Some(self.cycle_failure(&reqs, f.cycle, c, reference, f.what.clone()));
                 }
@@ -1632,7 +1650,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         ids
     }
 
-    /// The failure of cycle `i` against `reference`, saying `what`.
+    /// The failure of cycle `i` against `reference`, saying `what`, citing `reqs`.
     fn cycle_failure(
         &self,
         reqs: &[String],
@@ -1655,12 +1673,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             ),
             expected: self.family.describe(reference),
             got,
-            requirements: self.refs(&self.family.cited(
-                reqs,
-                &c.out,
-                c.dut.as_ref().ok(),
-                reference,
-            )),
+            requirements: self.refs(reqs),
         }
     }
 

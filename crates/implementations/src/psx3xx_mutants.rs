@@ -568,7 +568,7 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::NoLoopIgnored,
             name: "control bit 6 (no loop) ignored",
             must_fail: &["psx3xx/position/no-loop-down"],
-            breaks: &["PSX-CMD-008", "PSX-RUN-007", "PSX-TS-012"],
+            breaks: &["PSX-CMD-008", "PSX-RUN-007", "PSX-TS-012", "PSX-ADJ-004"],
         },
         Case {
             kind: Kind::TimeoutIgnored,

@@ -467,6 +467,13 @@ pub struct IsduErrorCase {
     /// Parameters concerned (empty = any).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub params: Vec<String>,
+    /// The requirement a device breaks that does not refuse in this situation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub requirement: Option<String>,
+    /// The refused value lies outside the parameter's own range: the parameter's range
+    /// requirement is broken before `requirement`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub range: bool,
     /// One line.
     pub text: String,
     /// Manual statement, or the IO-Link clause where the manual is silent.

@@ -517,7 +517,7 @@ impl<'a, 's> Gen<'a, 's> {
                 }
             }
         }
-        let range_req = format!("PSX-ISDU-{}-RANGE", p.id);
+        let range_req = range_requirement(&p.id);
         for (name, v, beyond) in values {
             let Some(data) = self.encode(p, v) else {
                 continue;
@@ -1576,4 +1576,10 @@ pub(crate) fn generate<'s>(
         }
     }
     Ok(g.out.into_iter().unzip())
+}
+
+/// The requirement that an ISDU entry accepts only its range (3.1 value ranges, 3.2 model
+/// ranges): `PSX-ISDU-<id>-RANGE`.
+pub(crate) fn range_requirement(id: &str) -> String {
+    format!("PSX-ISDU-{id}-RANGE")
 }

@@ -1,7 +1,7 @@
 //! Running PSx3xx cases ([`crate::cyclic_session`]): every cycle's input image (status word
 //! exact) and every ISDU and injection reply is compared with the reference's.
 
-use super::cases::{PsxCase, StepDef};
+use super::cases::{range_requirement, PsxCase, StepDef};
 use super::Psx3xxSuite;
 use crate::case::CaseInfo;
 use crate::cyclic::{Env, Reply, Request, Server};
@@ -13,7 +13,8 @@ use drivespec_psx3xx::isdu::ErrorType;
 use drivespec_psx3xx::model::LinkEvent;
 use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
-use drivespec_spec::{DataType, Family, FamilyId};
+use drivespec_spec::psx3xx::IsduErrorCase;
+use drivespec_spec::{DataType, Family, FamilyId, Parameter, RuleAction};
 
 /// A session on one device under test.
 pub type Psx3xxSession<'a, 's> = CyclicSession<'a, Psx3xx<'a, 's>>;
@@ -32,8 +33,21 @@ pub struct Psx3xx<'a, 's> {
 /// The requirement that multi-byte process values come most significant byte first (3.3.2).
 const BYTE_ORDER: &str = "PSX-PD-008";
 
+/// The requirement that format 2 runs at the speed in the process data (4.6.4).
+const PD_SPEED: &str = "PSX-VEL-005";
+
+/// The requirement that a format-2 speed of 0 runs at ISDU 142 or 145 (4.6.4).
+const PD_SPEED_ZERO: &str = "PSX-VEL-006";
+
+/// The prefix of the time-stamp requirements (3.3.1, 4.4): what a drive does in format 0
+/// follows from them.
+const TIME_STAMP: &str = "PSX-TS-";
+
 /// The status bit the runner waits on (manual 3.4 bit 6).
 const RUNNING: &str = "Drive is running";
+
+/// The bitfield of the status word (3.4).
+const STATUS: &str = "status";
 
 impl<'a, 's> Psx3xx<'a, 's> {
     /// The family of `suite`.
@@ -83,6 +97,86 @@ impl<'a, 's> Psx3xx<'a, 's> {
                 .or_else(|| name.strip_prefix("0X"))?;
             drivespec_spec::hex::parse_hex_digits(digits).map(ErrorType)
         })
+    }
+
+    /// The parameter an ISDU request addresses (3.1).
+    fn parameter(&self, req: &Request) -> Option<&'s Parameter> {
+        let (index, subindex) = match req {
+            Request::IsduRead {
+                index, subindex, ..
+            }
+            | Request::IsduWrite {
+                index, subindex, ..
+            } => (u32::from(*index), u32::from(*subindex)),
+            _ => return None,
+        };
+        let params = &self.suite.family().parameters;
+        params
+            .iter()
+            .find(|p| p.number == index && p.subindex == Some(subindex))
+            .or_else(|| {
+                params
+                    .iter()
+                    .find(|p| p.number == index && p.subindex.is_none())
+            })
+    }
+
+    /// The requirements of the situation in which the reference refused with `code`
+    /// (`protocol.isdu_errors.case`): among the situations with that code, the first that
+    /// names the parameter or whose requirement does, else the first for any parameter;
+    /// the parameter's range requirement first where the situation is a value outside it.
+    fn refusal(&self, code: ErrorType, param: Option<&Parameter>, case: &[String]) -> Vec<String> {
+        let Some(errors) = self.suite.family().psx3xx().map(|p| &p.isdu_errors) else {
+            return Vec::new();
+        };
+        let family = self.suite.family();
+        let names = |c: &&&IsduErrorCase| {
+            param.is_some_and(|p| {
+                c.params.contains(&p.id)
+                    || c.requirement
+                        .as_deref()
+                        .and_then(|r| family.requirement(r))
+                        .is_some_and(|r| r.params.contains(&p.id))
+            })
+        };
+        let with_code: Vec<&IsduErrorCase> =
+            errors.cases.iter().filter(|c| c.code == code.0).collect();
+        let Some(situation) = with_code
+            .iter()
+            .find(names)
+            .or_else(|| with_code.iter().find(|c| c.params.is_empty()))
+        else {
+            return Vec::new();
+        };
+        let mut ids = Vec::new();
+        if let Some(p) = param.filter(|_| situation.range) {
+            let own = range_requirement(&p.id);
+            if case.contains(&own) {
+                ids.push(own);
+            }
+        }
+        ids.extend(situation.requirement.clone());
+        ids
+    }
+
+    /// The rules of status bit `bit` (3.4), those that make it `set` first.
+    fn status_rules(&self, bit: u32, set: bool) -> Vec<String> {
+        let Some(b) = self
+            .suite
+            .family()
+            .bitfield(STATUS)
+            .and_then(|f| f.bits.iter().find(|x| x.bit == bit))
+        else {
+            return Vec::new();
+        };
+        let wanted = if set {
+            RuleAction::Set
+        } else {
+            RuleAction::Reset
+        };
+        let (mut first, rest): (Vec<_>, Vec<_>) = b.rules.iter().partition(|r| r.action == wanted);
+        first.extend(rest);
+        first.into_iter().map(|r| r.requirement.clone()).collect()
     }
 
     /// Whether the device's reply is the reference's exactly, or for an ISDU error the same
@@ -221,24 +315,92 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
         self.running_bit
     }
 
-    /// The case's requirements; first the byte order of the process data (PSX-PD-008) when
-    /// the device's status word is the reference's with its two octets swapped.
+    /// What differs, then `case`: the byte order of the process data (PSX-PD-008) when the
+    /// device's status word is the reference's with its two octets swapped; else while a
+    /// time stamp is sent (format 0) the time-stamp requirements of `case` (3.3.1, 4.4) and
+    /// the rules of every status bit that differs (3.4; those that give the reference's
+    /// value first); where the speeds differ in format 2, the process-data speed (4.6.4).
     fn cited(
         &self,
         case: &[String],
-        _out: &Output,
+        out: &Output,
         dut: Option<&Input>,
         reference: &Input,
     ) -> Vec<String> {
-        let swapped = dut.is_some_and(|d| {
-            d.status != reference.status && d.status == reference.status.swap_bytes()
-        });
         let mut ids: Vec<String> = Vec::new();
-        if swapped {
-            ids.push(BYTE_ORDER.to_owned());
+        if let Some(d) = dut {
+            if d.status != reference.status && d.status == reference.status.swap_bytes() {
+                ids.push(BYTE_ORDER.to_owned());
+            } else if d.status != reference.status {
+                if matches!(out, Output::TimeStamp { .. }) {
+                    ids.extend(case.iter().filter(|r| r.starts_with(TIME_STAMP)).cloned());
+                }
+                let differ = d.status ^ reference.status;
+                for bit in (0..16u32).filter(|b| differ & (1 << b) != 0) {
+                    ids.extend(self.status_rules(bit, reference.status & (1 << bit) != 0));
+                }
+            }
+            ids.extend(speed_cited(out, d, reference));
         }
-        ids.extend(case.iter().filter(|r| r.as_str() != BYTE_ORDER).cloned());
-        ids
+        merged(ids, case)
+    }
+
+    /// What the cycle shows, then `reqs` (a judgement's findings lead): the byte order of
+    /// the process data (PSX-PD-008) when the status word comes swapped; else while a time
+    /// stamp is sent (format 0: the run follows the stamp) the time-stamp requirements of
+    /// `reqs` (3.3.1, 4.4); where the speeds differ in format 2, the process-data speed
+    /// (4.6.4).
+    fn judged_cited(
+        &self,
+        reqs: &[String],
+        out: &Output,
+        dut: Option<&Input>,
+        reference: &Input,
+    ) -> Vec<String> {
+        let mut ids: Vec<String> = Vec::new();
+        if let Some(d) = dut {
+            if d.status != reference.status && d.status == reference.status.swap_bytes() {
+                ids.push(BYTE_ORDER.to_owned());
+            } else if matches!(out, Output::TimeStamp { .. }) {
+                ids.extend(reqs.iter().filter(|r| r.starts_with(TIME_STAMP)).cloned());
+            }
+            ids.extend(speed_cited(out, d, reference));
+        }
+        merged(ids, reqs)
+    }
+
+    /// What the reply shows, then `case`: where the reference refused with an ErrorType the
+    /// device did not give, the requirement of that refusal (`protocol.isdu_errors.case`;
+    /// the parameter's range requirement first for a value outside it); then the case's
+    /// requirements that concern the addressed parameter (a read whose value differs), in
+    /// the case's order.
+    fn reply_cited(
+        &self,
+        case: &[String],
+        req: &Request,
+        expected: &Reply,
+        got: &Reply,
+    ) -> Vec<String> {
+        let param = self.parameter(req);
+        let mut ids: Vec<String> = Vec::new();
+        if let Some(code) = self.error_code(expected) {
+            if self.error_code(got) != Some(code) {
+                ids.extend(self.refusal(code, param, case));
+            }
+        }
+        if let Some(p) = param {
+            let family = self.suite.family();
+            ids.extend(
+                case.iter()
+                    .filter(|r| {
+                        family
+                            .requirement(r)
+                            .is_some_and(|x| x.params.contains(&p.id))
+                    })
+                    .cloned(),
+            );
+        }
+        merged(ids, case)
     }
 
     /// The reference's reply exactly, or for an ISDU error the same ErrorType (named or hex)
@@ -389,6 +551,33 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
     fn answered(&self, _action: &Step, _reference: &Input) -> bool {
         true
     }
+}
+
+/// The process-data speed requirement (4.6.4; speed 0: ISDU 142/145) where the device's
+/// speed differs from the reference's in format 2.
+fn speed_cited(out: &Output, dut: &Input, reference: &Input) -> Option<String> {
+    let Output::SpeedControlTarget { target_speed, .. } = out else {
+        return None;
+    };
+    (dut.rpm != reference.rpm).then(|| {
+        if *target_speed == 0 {
+            PD_SPEED_ZERO
+        } else {
+            PD_SPEED
+        }
+        .to_owned()
+    })
+}
+
+/// `first`, then `rest`, each requirement once.
+fn merged(first: Vec<String>, rest: &[String]) -> Vec<String> {
+    let mut ids: Vec<String> = Vec::new();
+    for id in first.into_iter().chain(rest.iter().cloned()) {
+        if !ids.contains(&id) {
+            ids.push(id);
+        }
+    }
+    ids
 }
 
 /// `out` with the control word, target and target speed a `process` step gives (absent:
