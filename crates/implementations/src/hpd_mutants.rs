@@ -44,6 +44,9 @@ pub enum Kind {
     /// Every answer delayed by 25 ms whatever Pr26, as if every code were code 4 (4 table
     /// note (*)).
     AnswersLate,
+    /// END is taken only with a zero second byte; an END with any other second byte is
+    /// passed over like `LD 99.13`, so the instructions behind it run.
+    EndNeedsZeroByte,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -250,6 +253,35 @@ impl Mutant {
                         == Some(u32::from(par)) =>
             {
                 self.drop_ack = true;
+            }
+            (Kind::EndNeedsZeroByte, Some(Message::WritePlc { addr, par, data }))
+                if addr == own =>
+            {
+                let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec()).unwrap();
+                let passed_over =
+                    codec
+                        .decode(data.as_slice(), usize::from(par))
+                        .is_ok_and(|(i, _)| {
+                            codec.is_end(&i)
+                                && matches!(
+                                    i.operands,
+                                    drivespec_hpd::plc::Operands::None { spare1, .. } if spare1 != 0
+                                )
+                        });
+                if passed_over {
+                    let mut ld = Vec::new();
+                    let program = codec.parse_listing("LD 99.13").unwrap();
+                    for (_, i) in &program.instrs {
+                        codec.encode(i, &mut ld).unwrap();
+                    }
+                    let m = Message::WritePlc {
+                        addr,
+                        par,
+                        data: Data::new(&ld).unwrap(),
+                    };
+                    self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                    return;
+                }
             }
             (Kind::PlcWritableWhileRunning, Some(Message::WritePlc { addr, .. }))
                 if addr == own =>
@@ -617,6 +649,12 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::AnswersLate,
             breaks: v(&["HPD-BAUD-004"]),
             must_fail: &["hpd/frame/read-parameter", "hpd/param/Pr33/min"],
+        },
+        Case {
+            name: "END with a non-zero second byte passed over",
+            kind: Kind::EndNeedsZeroByte,
+            breaks: v(&["HPD-PLC-043"]),
+            must_fail: &["hpd/plc/end-second-byte"],
         },
         Case {
             name: "command bits stay set",
