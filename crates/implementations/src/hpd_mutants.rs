@@ -47,12 +47,18 @@ pub enum Kind {
     /// END is taken only with a zero second byte; an END with any other second byte is
     /// passed over like `LD 99.13`, so the instructions behind it run.
     EndNeedsZeroByte,
+    /// Pr35 shows the torque request before the current limit: 150.0 % of peak while the
+    /// shaft turns.
+    TorqueBeyondPeak,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
 
 /// The answer delay of Pr26 = 4 (4 table note (*)), which `AnswersLate` adds on every code.
 const ANSWER_DELAY_US: Micros = 25_000;
+
+/// What `TorqueBeyondPeak` shows in Pr35 while the shaft turns: 150.0 % of peak.
+const UNLIMITED_TORQUE: i64 = 1500;
 
 /// A drive with a deviation.
 #[derive(Clone)]
@@ -426,6 +432,15 @@ impl SimDevice for Mutant {
         if self.kind == Kind::FinAnywhere {
             self.late_fins(now);
         }
+        if self.kind == Kind::TorqueBeyondPeak {
+            let family = spec().family(FamilyId::Hpd);
+            let speed = Target::parse(family, "Pr0").unwrap();
+            let torque = Target::parse(family, "Pr35").unwrap();
+            let turning = self.inner.value(&speed).unwrap_or(0) != 0;
+            let _ = self
+                .inner
+                .set_value(now, &torque, if turning { UNLIMITED_TORQUE } else { 0 });
+        }
         if self.kind == Kind::FastTimer {
             let after = self.inner.value(&timer).unwrap_or(0);
             if after < before && after > 0 {
@@ -655,6 +670,15 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::EndNeedsZeroByte,
             breaks: v(&["HPD-PLC-043"]),
             must_fail: &["hpd/plc/end-second-byte"],
+        },
+        Case {
+            name: "Pr35 beyond the peak while turning",
+            kind: Kind::TorqueBeyondPeak,
+            breaks: v(&["HPD-PAR-048"]),
+            must_fail: &[
+                "hpd/motion/mode-8/jog-forward",
+                "hpd/motion/mode-8/jog-reverse",
+            ],
         },
         Case {
             name: "command bits stay set",

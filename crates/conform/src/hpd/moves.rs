@@ -60,6 +60,9 @@ const WINDOW: (i64, i64) = (700, 400);
 const INTERNAL_RPM: i64 = 250;
 /// Spindle orientation speed Pr50 (rpm).
 const ORIENT_RPM: i64 = 200;
+/// Pr35 is in % of the drive's peak (manual 3.3): the torque a drive delivers is at most its
+/// peak, 100 % either way.
+const PEAK_PERCENT: f64 = 100.0;
 /// Positioning profile: Pr51 (ms per 1000 rpm), Pr52 (rpm), revolutions.
 const PROFILE: (i64, i64, i64) = (200, 600, 5);
 
@@ -95,6 +98,9 @@ struct Motion {
     reference: Probe,
     flags41: Probe,
     flags70: Probe,
+    torque: Probe,
+    /// Pr35's raw value at the drive's peak torque.
+    peak: i64,
     slots: Vec<(u8, Slot)>,
     bit_lag_us: u64,
     /// The drive's slow operating-mode slot (µs): a drive may change its speed and position
@@ -140,6 +146,8 @@ impl Motion {
             reference: probe("Pr60", Some(4))?,
             flags41: probe("Pb41", None)?,
             flags70: probe("Pb70", None)?,
+            torque: probe(names::TORQUE_MONITOR, None)?,
+            peak: peak_raw(g.param(names::TORQUE_MONITOR)?.scale?),
             slots,
             bit_lag_us: u64::from(lag.period_us) + BIT_LAG_SLACK_US,
             slot_us: u64::from(slot.period_us),
@@ -168,6 +176,16 @@ impl Motion {
             .iter()
             .find(|(k, _)| *k == n)
             .map_or(Slot { addr: 0, size: 0 }, |(_, s)| *s)
+    }
+}
+
+/// The raw value of [`PEAK_PERCENT`] in steps of `scale` %.
+fn peak_raw(scale: f64) -> i64 {
+    let steps = (PEAK_PERCENT / scale).round();
+    if steps.is_finite() && steps.abs() < 1e15 {
+        steps as i64
+    } else {
+        0
     }
 }
 
@@ -315,7 +333,7 @@ fn pb40_with(g: &Gen, m: &Motion, bits: &[&str]) -> i64 {
 }
 
 /// HPD-MODE-8-001: jog with b70.1 (forward) or b70.2 (reverse) at Pr50, on the Pr8..Pr11
-/// ramps, then back to standstill.
+/// ramps, then back to standstill; HPD-PAR-048: Pr35 within ± the peak while it turns.
 fn jog(g: &mut Gen, m: &Motion, forward: bool) {
     let (name, jog_bit, up, down) = if forward {
         ("forward", "b70.1", m.pr(8), m.pr(9))
@@ -334,7 +352,7 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
     let mut cb = CaseB::new(
         format!("hpd/motion/mode-8/jog-{name}"),
         format!(
-            "mode 8 with b40.2 = 1: {jog_bit} turns the shaft {name} at Pr50 = {JOG_RPM} rpm on the ramps, and back to 0 rpm when cleared; b41.0–b41.3 follow the speed"
+            "mode 8 with b40.2 = 1: {jog_bit} turns the shaft {name} at Pr50 = {JOG_RPM} rpm on the ramps, and back to 0 rpm when cleared; b41.0–b41.3 follow the speed; Pr35 stays within the drive's peak while it turns"
         ),
         &[],
     );
@@ -408,6 +426,21 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
             target + SPEED_SLACK_RPM,
         )],
         checks,
+    );
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr0 and Pr35 while the shaft turns at {target} rpm"),
+        vec![m.speed, m.torque],
+        HOLD_US,
+        Vec::new(),
+        vec![check(
+            "HPD-PAR-048",
+            Envelope::Bounded {
+                within: within(1, -m.peak, m.peak),
+            },
+        )],
     );
     g.bit(&mut cb, Role::Check, &bit, false);
     let mut checks = vec![
