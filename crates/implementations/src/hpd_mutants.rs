@@ -50,6 +50,8 @@ pub enum Kind {
     /// Pr35 shows the torque request before the current limit: 150.0 % of peak while the
     /// shaft turns.
     TorqueBeyondPeak,
+    /// b41.5 (hardware enable status) always reads 0.
+    EnableStatusNeverSet,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -397,6 +399,24 @@ impl Mutant {
                 };
                 m.to_bytes(&self.rules).unwrap()
             }
+            (Kind::EnableStatusNeverSet, Message::Response { addr, par, data })
+                if spec()
+                    .family(FamilyId::Hpd)
+                    .parameter("Pb41")
+                    .and_then(|p| p.address)
+                    == Some(u32::from(par)) =>
+            {
+                let mut d = data.as_slice().to_vec();
+                if let Some(low) = d.first_mut() {
+                    *low &= !(1 << 5);
+                }
+                let m = Message::Response {
+                    addr,
+                    par,
+                    data: Data::new(&d).unwrap(),
+                };
+                m.to_bytes(&self.rules).unwrap()
+            }
             (Kind::AckWithChecksum, Message::Ack { .. }) => {
                 let mut b = bytes.clone();
                 let chk = b.get(1).copied().unwrap_or(0);
@@ -647,7 +667,7 @@ pub fn mutants() -> Vec<Case> {
         Case {
             name: "digital inputs never read",
             kind: Kind::DeafInputs,
-            breaks: v(&["HPD-BIT-90-INPUTS"]),
+            breaks: v(&["HPD-BIT-90-INPUTS", "HPD-BIT-41-5"]),
             must_fail: &[
                 "hpd/plc/vector/plc-ld-out",
                 "hpd/plc/vector/plc-default-limits-enabled-closed",
@@ -679,6 +699,12 @@ pub fn mutants() -> Vec<Case> {
                 "hpd/motion/mode-8/jog-forward",
                 "hpd/motion/mode-8/jog-reverse",
             ],
+        },
+        Case {
+            name: "b41.5 never set",
+            kind: Kind::EnableStatusNeverSet,
+            breaks: v(&["HPD-BIT-41-5"]),
+            must_fail: &["hpd/bit/b41.5/hardware-enable"],
         },
         Case {
             name: "command bits stay set",

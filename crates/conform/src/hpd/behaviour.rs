@@ -23,6 +23,7 @@ pub(crate) fn generate(g: &mut Gen) {
     plc_vectors(g);
     timers(g);
     power_up(g);
+    hardware_enable(g);
 }
 
 /// Another address than the device's own, picked by the seed.
@@ -1457,5 +1458,73 @@ fn power_up(g: &mut Gen) {
     );
     g.restore(&mut cb, flag.slot, "Pb90");
     g.bit(&mut cb, Role::Cleanup, &save_ref, true);
+    g.push(cb);
+}
+
+/// HPD-BIT-41-5: b41.5 shows the hardware enable input (manual 3.3 b41.5; 3.8.1 "b90.0 =
+/// drive enable"): set after the input is applied, reset after it is removed. The manual
+/// does not say which task of appendix F updates b41.5; each read waits two periods of the
+/// slowest task slot, which covers every slot.
+fn hardware_enable(g: &mut Gen) {
+    let io = &g.protocol.io;
+    let (Some(enable), Some(status)) = (
+        io.inputs
+            .iter()
+            .find(|i| i.index == io.enable_input)
+            .map(|i| i.bit.clone()),
+        g.bit_ref(names::HARDWARE_ENABLE),
+    ) else {
+        return;
+    };
+    let Some(mask) = 1u16.checked_shl(u32::from(io.enable_input)) else {
+        return;
+    };
+    let wait = 2 * g
+        .protocol
+        .task_slots
+        .iter()
+        .map(|s| u64::from(s.period_us))
+        .max()
+        .unwrap_or(u64::from(g.protocol.plc.scan_us));
+    let start = g.baseline.digital_inputs();
+    let mut cb = CaseB::new(
+        "hpd/bit/b41.5/hardware-enable",
+        format!(
+            "{} follows the hardware enable input {enable}: 1 with the input applied, 0 with it removed",
+            names::HARDWARE_ENABLE
+        ),
+        &["HPD-BIT-41-5"],
+    );
+    let cmp = Compare::Mask(bit_value(status.slot, status.at));
+    for (value, what) in [(start | mask, "applied"), (start & !mask, "removed")] {
+        cb.action(
+            Role::Setup,
+            Action::Inputs { value },
+            format!("hardware enable input {enable} {what}: inputs {value:#06x}"),
+            &[],
+        );
+        cb.action(
+            Role::Setup,
+            Action::Listen { us: wait },
+            "listen for two periods of the slowest task slot",
+            &[],
+        );
+        g.read(
+            &mut cb,
+            Role::Check,
+            status.slot,
+            cmp,
+            status.param.id.as_str(),
+        );
+        if let Some(step) = cb.steps.last_mut() {
+            step.requirements.insert(0, "HPD-BIT-41-5".to_owned());
+        }
+    }
+    cb.action(
+        Role::Cleanup,
+        Action::Inputs { value: start },
+        "the digital inputs as at the start",
+        &[],
+    );
     g.push(cb);
 }

@@ -167,11 +167,14 @@ impl Drive {
     }
 
     /// Status the model keeps: HPD-BIT-41-4, drive healthy while no alarm is active (the DC
-    /// bus is taken as ready).
+    /// bus is taken as ready); HPD-BIT-41-5, the hardware enable input as last read.
     pub(super) fn refresh_status(&mut self) {
         if let Some(b) = self.layout.named.healthy {
             let healthy = self.alarms().active == 0;
             self.working.set_bit(b, healthy);
+        }
+        if let Some((b, input)) = self.layout.named.hardware_enable {
+            self.working.set_bit(b, self.inputs & input != 0);
         }
         self.refresh_motor_status();
     }

@@ -111,6 +111,8 @@ pub(super) struct Named {
     pub(super) reserved_reference: BitAddr,
     pub(super) idc_trigger: BitAddr,
     pub(super) healthy: Option<BitAddr>,
+    /// The hardware enable status bit (b41.5) and the input it shows (bit mask of the inputs).
+    pub(super) hardware_enable: Option<(BitAddr, u16)>,
     pub(super) baud: Slot,
     pub(super) address: Slot,
     pub(super) alarm: Slot,
@@ -242,6 +244,7 @@ impl Layout {
             reserved_reference: bit(&protocol.commands.mode_defaults_requires_clear)?,
             idc_trigger: bit(&protocol.idc.trigger_bit)?,
             healthy: None,
+            hardware_enable: None,
             baud: slot(&setup_spec.baud_param)?,
             address: slot(&setup_spec.address_param)?,
             alarm: slot(&protocol.commands.alarm_param)?,
@@ -276,6 +279,10 @@ impl Layout {
         let mut commands = Vec::new();
         let mut power_on_reset = Vec::new();
         let mut healthy = None;
+        let mut hardware_enable = None;
+        let enable_input = 1u16
+            .checked_shl(u32::from(protocol.io.enable_input))
+            .unwrap_or(0);
         for bf in &family.bitfields {
             let Some(p) = family.parameter(&bf.param) else {
                 continue;
@@ -317,6 +324,9 @@ impl Layout {
                         }
                         (names::TRIGGER_POWER_ON, RuleAction::Reset) => power_on_reset.push(addr),
                         (names::TRIGGER_ALARM_RAISED, RuleAction::Reset) => healthy = Some(addr),
+                        (names::TRIGGER_HARDWARE_ENABLE, RuleAction::Set) => {
+                            hardware_enable = Some((addr, enable_input));
+                        }
                         _ => {}
                     }
                 }
@@ -330,7 +340,11 @@ impl Layout {
                 )));
             }
         }
-        let named = Named { healthy, ..named };
+        let named = Named {
+            healthy,
+            hardware_enable,
+            ..named
+        };
 
         let mut saved_mask = [0u8; 256];
         let mut factory = Memory::default();
