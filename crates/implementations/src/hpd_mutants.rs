@@ -52,6 +52,8 @@ pub enum Kind {
     TorqueBeyondPeak,
     /// b41.5 (hardware enable status) always reads 0.
     EnableStatusNeverSet,
+    /// b41.12 (drive enabled) shows the hardware enable alone, whatever b40.9.
+    EnabledIgnoresSoftwareEnable,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -417,6 +419,30 @@ impl Mutant {
                 };
                 m.to_bytes(&self.rules).unwrap()
             }
+            (Kind::EnabledIgnoresSoftwareEnable, Message::Response { addr, par, data })
+                if spec()
+                    .family(FamilyId::Hpd)
+                    .parameter("Pb41")
+                    .and_then(|p| p.address)
+                    == Some(u32::from(par))
+                    && data.len() == 2 =>
+            {
+                let mut d = data.as_slice().to_vec();
+                let hardware = d.first().is_some_and(|low| low & (1 << 5) != 0);
+                if let Some(high) = d.get_mut(1) {
+                    *high = if hardware {
+                        *high | (1 << 4)
+                    } else {
+                        *high & !(1 << 4)
+                    };
+                }
+                let m = Message::Response {
+                    addr,
+                    par,
+                    data: Data::new(&d).unwrap(),
+                };
+                m.to_bytes(&self.rules).unwrap()
+            }
             (Kind::AckWithChecksum, Message::Ack { .. }) => {
                 let mut b = bytes.clone();
                 let chk = b.get(1).copied().unwrap_or(0);
@@ -667,7 +693,7 @@ pub fn mutants() -> Vec<Case> {
         Case {
             name: "digital inputs never read",
             kind: Kind::DeafInputs,
-            breaks: v(&["HPD-BIT-90-INPUTS", "HPD-BIT-41-5"]),
+            breaks: v(&["HPD-BIT-90-INPUTS", "HPD-BIT-41-5", "HPD-BIT-41-12"]),
             must_fail: &[
                 "hpd/plc/vector/plc-ld-out",
                 "hpd/plc/vector/plc-default-limits-enabled-closed",
@@ -705,6 +731,12 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::EnableStatusNeverSet,
             breaks: v(&["HPD-BIT-41-5"]),
             must_fail: &["hpd/bit/b41.5/hardware-enable"],
+        },
+        Case {
+            name: "b41.12 ignores b40.9",
+            kind: Kind::EnabledIgnoresSoftwareEnable,
+            breaks: v(&["HPD-BIT-41-12"]),
+            must_fail: &["hpd/bit/b41.12/drive-enabled"],
         },
         Case {
             name: "command bits stay set",

@@ -1461,24 +1461,28 @@ fn power_up(g: &mut Gen) {
     g.push(cb);
 }
 
-/// HPD-BIT-41-5: b41.5 shows the hardware enable input (manual 3.3 b41.5; 3.8.1 "b90.0 =
-/// drive enable"): set after the input is applied, reset after it is removed. The manual
-/// does not say which task of appendix F updates b41.5; each read waits two periods of the
-/// slowest task slot, which covers every slot.
+/// HPD-BIT-41-5 and HPD-BIT-41-12 (manual 3.3 b41.5, b41.12, b40.9; 3.8.1 "b90.0 = drive
+/// enable"): b41.5 shows the hardware enable input; b41.12 is 1 with the input applied and
+/// b40.9 = 1, and 0 with either withdrawn. The manual does not say which task of appendix F
+/// updates them; each read waits two periods of the slowest task slot, which covers every
+/// slot.
 fn hardware_enable(g: &mut Gen) {
     let io = &g.protocol.io;
-    let (Some(enable), Some(status)) = (
+    let (Some(enable), Some(status), Some(enabled), Some(software)) = (
         io.inputs
             .iter()
             .find(|i| i.index == io.enable_input)
             .map(|i| i.bit.clone()),
         g.bit_ref(names::HARDWARE_ENABLE),
+        g.bit_ref(names::DRIVE_ENABLED),
+        g.bit_ref(&io.software_enable_bit),
     ) else {
         return;
     };
     let Some(mask) = 1u16.checked_shl(u32::from(io.enable_input)) else {
         return;
     };
+    let sw = io.software_enable_bit.clone();
     let wait = 2 * g
         .protocol
         .task_slots
@@ -1487,6 +1491,29 @@ fn hardware_enable(g: &mut Gen) {
         .max()
         .unwrap_or(u64::from(g.protocol.plc.scan_us));
     let start = g.baseline.digital_inputs();
+    let inputs = |cb: &mut CaseB, value: u16, what: &str| {
+        cb.action(
+            Role::Setup,
+            Action::Inputs { value },
+            format!("hardware enable input {enable} {what}: inputs {value:#06x}"),
+            &[],
+        );
+    };
+    // Waits, then reads `bit` (only it compared) checking `requirement`.
+    let read = |g: &mut Gen, cb: &mut CaseB, bit: &BitRef, requirement: &str| {
+        cb.action(
+            Role::Setup,
+            Action::Listen { us: wait },
+            "listen for two periods of the slowest task slot",
+            &[],
+        );
+        let cmp = Compare::Mask(bit_value(bit.slot, bit.at));
+        g.read(cb, Role::Check, bit.slot, cmp, bit.param.id.as_str());
+        if let Some(step) = cb.steps.last_mut() {
+            step.requirements.insert(0, requirement.to_owned());
+        }
+    };
+
     let mut cb = CaseB::new(
         "hpd/bit/b41.5/hardware-enable",
         format!(
@@ -1495,30 +1522,9 @@ fn hardware_enable(g: &mut Gen) {
         ),
         &["HPD-BIT-41-5"],
     );
-    let cmp = Compare::Mask(bit_value(status.slot, status.at));
     for (value, what) in [(start | mask, "applied"), (start & !mask, "removed")] {
-        cb.action(
-            Role::Setup,
-            Action::Inputs { value },
-            format!("hardware enable input {enable} {what}: inputs {value:#06x}"),
-            &[],
-        );
-        cb.action(
-            Role::Setup,
-            Action::Listen { us: wait },
-            "listen for two periods of the slowest task slot",
-            &[],
-        );
-        g.read(
-            &mut cb,
-            Role::Check,
-            status.slot,
-            cmp,
-            status.param.id.as_str(),
-        );
-        if let Some(step) = cb.steps.last_mut() {
-            step.requirements.insert(0, "HPD-BIT-41-5".to_owned());
-        }
+        inputs(&mut cb, value, what);
+        read(g, &mut cb, &status, "HPD-BIT-41-5");
     }
     cb.action(
         Role::Cleanup,
@@ -1526,5 +1532,30 @@ fn hardware_enable(g: &mut Gen) {
         "the digital inputs as at the start",
         &[],
     );
+    g.push(cb);
+
+    let mut cb = CaseB::new(
+        "hpd/bit/b41.12/drive-enabled",
+        format!(
+            "{} is 1 with the hardware enable input {enable} applied and {sw} = 1, 0 after {sw} = 0, and 0 with {sw} = 1 and the input removed",
+            names::DRIVE_ENABLED
+        ),
+        &["HPD-BIT-41-12"],
+    );
+    g.bit(&mut cb, Role::Setup, &software, true);
+    inputs(&mut cb, start | mask, "applied");
+    read(g, &mut cb, &enabled, "HPD-BIT-41-12");
+    g.bit(&mut cb, Role::Setup, &software, false);
+    read(g, &mut cb, &enabled, "HPD-BIT-41-12");
+    g.bit(&mut cb, Role::Setup, &software, true);
+    inputs(&mut cb, start & !mask, "removed");
+    read(g, &mut cb, &enabled, "HPD-BIT-41-12");
+    cb.action(
+        Role::Cleanup,
+        Action::Inputs { value: start },
+        "the digital inputs as at the start",
+        &[],
+    );
+    g.restore(&mut cb, software.slot, software.param.id.as_str());
     g.push(cb);
 }
