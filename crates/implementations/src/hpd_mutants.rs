@@ -54,6 +54,9 @@ pub enum Kind {
     EnableStatusNeverSet,
     /// b41.12 (drive enabled) shows the hardware enable alone, whatever b40.9.
     EnabledIgnoresSoftwareEnable,
+    /// A write of Pr66 while a mode-9 profile executes (b70.7 = 1) abandons the profile, as
+    /// if the profile generator lost its working data (the drive drops to mode 0).
+    ReservedWriteStopsProfile,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
@@ -263,6 +266,24 @@ impl Mutant {
                         == Some(u32::from(par)) =>
             {
                 self.drop_ack = true;
+            }
+            (Kind::ReservedWriteStopsProfile, Some(Message::WriteParam { addr, par, .. }))
+                if addr == own
+                    && spec()
+                        .family(FamilyId::Hpd)
+                        .parameter("Pr66")
+                        .and_then(|p| p.address)
+                        == Some(u32::from(par)) =>
+            {
+                let family = spec().family(FamilyId::Hpd);
+                let busy = Target::parse(family, "b70.7").unwrap();
+                let running = self.inner.value(&busy).unwrap_or(0) != 0;
+                self.inner.handle_rx(now, bytes);
+                if running {
+                    let mode = Target::parse(family, "Pr31").unwrap();
+                    let _ = self.inner.set_value(now, &mode, 0);
+                }
+                return;
             }
             (Kind::EndNeedsZeroByte, Some(Message::WritePlc { addr, par, data }))
                 if addr == own =>
@@ -737,6 +758,12 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::EnabledIgnoresSoftwareEnable,
             breaks: v(&["HPD-BIT-41-12"]),
             must_fail: &["hpd/bit/b41.12/drive-enabled"],
+        },
+        Case {
+            name: "Pr66 write stops a running profile",
+            kind: Kind::ReservedWriteStopsProfile,
+            breaks: v(&["HPD-MODE-9-008"]),
+            must_fail: &["hpd/motion/mode-9/reserved-while-busy"],
         },
         Case {
             name: "command bits stay set",

@@ -79,6 +79,7 @@ pub(crate) fn generate(g: &mut Gen) {
     positioning(g, &m, false);
     positioning(g, &m, true);
     locked_while_busy(g, &m);
+    reserved_while_busy(g, &m);
     clear_increment(g, &m);
     wiring_test(g, &m);
     feed_forward_defaults(g, &m);
@@ -120,7 +121,7 @@ impl Motion {
             })
         };
         let slots = [
-            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 54, 56, 57, 64,
+            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 54, 56, 57, 64, 66,
         ]
         .iter()
         .map(|n| Some((*n, g.slot_of(&format!("Pr{n}"))?)))
@@ -853,6 +854,115 @@ fn locked_while_busy(g: &mut Gen, m: &Motion) {
         Vec::new(),
     );
     command(g, &mut cb, Role::Cleanup, "b70.10");
+    g.restore(&mut cb, increment, "Pr64:65");
+    cleanup(g, &mut cb, m, &values);
+    g.push(cb);
+}
+
+/// HPD-MODE-9-008: Pr66:67 is reserved while a profile is generated (manual 3.6.4: "cannot
+/// be used during profile generation"). The manual does not say what a write of it then
+/// does: its answer (acknowledge or silence) and the value read back are each accepted and
+/// reported. 3.6.4 allows no change of a running profile but of Pr64:65: the write, made at
+/// the cruise speed, leaves the shaft at that speed, and the profile ends at its target
+/// (HPD-MODE-9-001).
+fn reserved_while_busy(g: &mut Gen, m: &Motion) {
+    let (accel, top, _) = PROFILE;
+    let steps = 6 * STEPS_PER_REV;
+    let slow = top / 2;
+    let window = 100;
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-9/reserved-while-busy",
+        format!(
+            "mode 9: a write of Pr66:67 while a profile of {steps} steps at {slow} rpm executes may be taken, refused or ignored; the profile still ends within Pr56 of its target"
+        ),
+        &[],
+    );
+    let values = [
+        (m.pr(51), accel, "Pr51"),
+        (m.pr(52), slow, "Pr52"),
+        (m.pr(56), window, "Pr56"),
+    ];
+    setup(g, &mut cb, m, 9, &values);
+    let increment = Slot {
+        addr: m.pr(64).addr,
+        size: 4,
+    };
+    let reserved = Slot {
+        addr: m.pr(66).addr,
+        size: 4,
+    };
+    g.write(&mut cb, Role::Setup, increment, steps, "Pr64:65");
+    let pb40 = pb40_with(g, m, &[names::RESERVED_REFERENCE]);
+    g.write(&mut cb, Role::Setup, m.pb40, pb40, "Pb40 (b40.2 = 1)");
+    command(g, &mut cb, Role::Setup, "b70.10");
+    command(g, &mut cb, Role::Setup, "b70.8");
+    let cruise = within(0, slow - SPEED_SLACK_RPM, slow + SPEED_SLACK_RPM);
+    watch(
+        g,
+        &mut cb,
+        Role::Setup,
+        &format!("wait until Pr0 = {slow} rpm"),
+        vec![m.speed],
+        time_bound(slow, accel),
+        vec![cruise],
+        Vec::new(),
+    );
+    if let Some(step) = cb.steps.last_mut() {
+        if let Action::Watch { hold_us, .. } = &mut step.action {
+            *hold_us = 0;
+        }
+    }
+    g.write(
+        &mut cb,
+        Role::Check,
+        reserved,
+        steps,
+        "Pr66:67 (while the profile runs)",
+    );
+    if let Some(step) = cb.steps.last_mut() {
+        step.requirements.insert(0, "HPD-MODE-9-008".to_owned());
+        if let Action::Exchange { silence_ok, .. } = &mut step.action {
+            *silence_ok = true;
+        }
+    }
+    g.read_open(
+        &mut cb,
+        reserved,
+        (0, i64::from(i32::MIN), i64::from(i32::MAX)),
+        "HPD-MODE-9-008",
+        "Pr66:67",
+    );
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr0 at {slow} rpm after the write"),
+        vec![m.speed],
+        HOLD_US,
+        Vec::new(),
+        vec![check(
+            "HPD-MODE-9-008",
+            Envelope::Bounded { within: cruise },
+        )],
+    );
+    let ideal_us = u64::try_from(steps * 60_000_000 / STEPS_PER_REV / slow).unwrap_or(0);
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr62:63 and Pb70 until b70.7 = 0 at {steps}"),
+        vec![m.position, m.flags70],
+        ideal_us * TIME_FACTOR_PERCENT / 100 + TIME_EXTRA_US,
+        vec![bit_is(1, 7, 0), within(0, steps - window, steps + window)],
+        vec![check(
+            "HPD-MODE-9-001",
+            Envelope::Ends {
+                within: within(0, steps - window, steps + window),
+            },
+        )],
+    );
+    command(g, &mut cb, Role::Cleanup, "b70.10");
+    g.restore(&mut cb, reserved, "Pr66:67");
     g.restore(&mut cb, increment, "Pr64:65");
     cleanup(g, &mut cb, m, &values);
     g.push(cb);
