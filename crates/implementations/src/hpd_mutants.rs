@@ -54,6 +54,9 @@ pub enum Kind {
     EnableStatusNeverSet,
     /// b41.12 (drive enabled) shows the hardware enable alone, whatever b40.9.
     EnabledIgnoresSoftwareEnable,
+    /// b70.5 in mode 9 shows only the present servo error: the drive clears it in its next
+    /// 49.152 ms slot (appendix F, the slowest) when the position error lies within Pr56.
+    ServoErrorNotLatched,
     /// A write of Pr66 while a mode-9 profile executes (b70.7 = 1) abandons the profile, as
     /// if the profile generator lost its working data (the drive drops to mode 0).
     ReservedWriteStopsProfile,
@@ -63,6 +66,9 @@ pub enum Kind {
 
 /// The answer delay of Pr26 = 4 (4 table note (*)), which `AnswersLate` adds on every code.
 const ANSWER_DELAY_US: Micros = 25_000;
+
+/// The slot in which `ServoErrorNotLatched` clears b70.5 (appendix F, speed windows manager).
+const SERVO_SLOT_US: Micros = 49_152;
 
 /// What `TorqueBeyondPeak` shows in Pr35 while the shaft turns: 150.0 % of peak.
 const UNLIMITED_TORQUE: i64 = 1500;
@@ -79,6 +85,8 @@ pub struct Mutant {
     extra: Vec<Output>,
     /// `SilentSetupWrite`: the next acknowledge is dropped.
     drop_ack: bool,
+    /// `ServoErrorNotLatched`: since when b70.5 has been 1.
+    servo_since: Option<Micros>,
 }
 
 impl Mutant {
@@ -99,6 +107,7 @@ impl Mutant {
             held: Vec::new(),
             extra: Vec::new(),
             drop_ack: false,
+            servo_since: None,
         }
     }
 
@@ -499,6 +508,18 @@ impl SimDevice for Mutant {
         if self.kind == Kind::FinAnywhere {
             self.late_fins(now);
         }
+        if self.kind == Kind::ServoErrorNotLatched && self.mode() == 9 {
+            let servo = Target::parse(spec().family(FamilyId::Hpd), "b70.5").unwrap();
+            if self.inner.value(&servo).unwrap_or(0) == 0 {
+                self.servo_since = None;
+            } else {
+                let since = *self.servo_since.get_or_insert(now);
+                if now.saturating_sub(since) >= SERVO_SLOT_US {
+                    let _ = self.inner.set_value(now, &servo, 0);
+                    self.servo_since = None;
+                }
+            }
+        }
         if self.kind == Kind::TorqueBeyondPeak {
             let family = spec().family(FamilyId::Hpd);
             let speed = Target::parse(family, "Pr0").unwrap();
@@ -764,6 +785,12 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::ReservedWriteStopsProfile,
             breaks: v(&["HPD-MODE-9-008"]),
             must_fail: &["hpd/motion/mode-9/reserved-while-busy"],
+        },
+        Case {
+            name: "b70.5 not latched in mode 9",
+            kind: Kind::ServoErrorNotLatched,
+            breaks: v(&["HPD-MODE-SERVO-ERROR-LATCH"]),
+            must_fail: &["hpd/motion/mode-9/servo-error-latched"],
         },
         Case {
             name: "command bits stay set",

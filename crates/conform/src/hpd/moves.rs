@@ -81,6 +81,7 @@ pub(crate) fn generate(g: &mut Gen) {
     locked_while_busy(g, &m);
     reserved_while_busy(g, &m);
     clear_increment(g, &m);
+    servo_error_latch(g, &m);
     wiring_test(g, &m);
     feed_forward_defaults(g, &m);
     resets(g, &m);
@@ -987,6 +988,46 @@ fn clear_increment(g: &mut Gen, m: &Motion) {
         step.requirements.insert(0, "HPD-MODE-9-005".to_owned());
     }
     g.restore(&mut cb, increment, "Pr64:65");
+    g.restore(&mut cb, m.pb70, "Pb70");
+    g.restore(&mut cb, m.mode, "Pr31");
+    g.restore_pb99(&mut cb);
+    g.push(cb);
+}
+
+/// HPD-MODE-SERVO-ERROR-LATCH: in mode 9 b70.5, once 1, stays 1 until the user resets it
+/// (manual 3.6.4: "If b70.5 is utilised it must be reset by the user"). Set over the line at
+/// standstill, it is still 1 after two periods of the slowest task slot (appendix F), however
+/// the position error then compares with Pr56.
+fn servo_error_latch(g: &mut Gen, m: &Motion) {
+    let Some(servo) = g.bit_ref("b70.5") else {
+        return;
+    };
+    let wait = 2 * g
+        .protocol
+        .task_slots
+        .iter()
+        .map(|s| u64::from(s.period_us))
+        .max()
+        .unwrap_or(m.slot_us);
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-9/servo-error-latched",
+        "mode 9: b70.5 set over the line stays 1 until the user clears it",
+        &[],
+    );
+    setup(g, &mut cb, m, 9, &[]);
+    g.bit(&mut cb, Role::Setup, &servo, true);
+    cb.action(
+        Role::Setup,
+        Action::Listen { us: wait },
+        "listen for two periods of the slowest task slot",
+        &[],
+    );
+    let cmp = Compare::Mask(bit_value(m.pb70, servo.at));
+    g.read(&mut cb, Role::Check, m.pb70, cmp, "Pb70");
+    if let Some(step) = cb.steps.last_mut() {
+        step.requirements
+            .insert(0, "HPD-MODE-SERVO-ERROR-LATCH".to_owned());
+    }
     g.restore(&mut cb, m.pb70, "Pb70");
     g.restore(&mut cb, m.mode, "Pr31");
     g.restore_pb99(&mut cb);
