@@ -44,12 +44,34 @@ pub enum Kind {
     /// Every answer delayed by 25 ms whatever Pr26, as if every code were code 4 (4 table
     /// note (*)).
     AnswersLate,
+    /// END is taken only with a zero second byte; an END with any other second byte is
+    /// passed over like `LD 99.13`, so the instructions behind it run.
+    EndNeedsZeroByte,
+    /// Pr35 shows the torque request before the current limit: 150.0 % of peak while the
+    /// shaft turns.
+    TorqueBeyondPeak,
+    /// b41.5 (hardware enable status) always reads 0.
+    EnableStatusNeverSet,
+    /// b41.12 (drive enabled) shows the hardware enable alone, whatever b40.9.
+    EnabledIgnoresSoftwareEnable,
+    /// b70.5 in mode 9 shows only the present servo error: the drive clears it in its next
+    /// 49.152 ms slot (appendix F, the slowest) when the position error lies within Pr56.
+    ServoErrorNotLatched,
+    /// A write of Pr66 while a mode-9 profile executes (b70.7 = 1) abandons the profile, as
+    /// if the profile generator lost its working data (the drive drops to mode 0).
+    ReservedWriteStopsProfile,
     /// An erratum reading instead of the adopted one.
     Reading(&'static str, &'static str),
 }
 
 /// The answer delay of Pr26 = 4 (4 table note (*)), which `AnswersLate` adds on every code.
 const ANSWER_DELAY_US: Micros = 25_000;
+
+/// The slot in which `ServoErrorNotLatched` clears b70.5 (appendix F, speed windows manager).
+const SERVO_SLOT_US: Micros = 49_152;
+
+/// What `TorqueBeyondPeak` shows in Pr35 while the shaft turns: 150.0 % of peak.
+const UNLIMITED_TORQUE: i64 = 1500;
 
 /// A drive with a deviation.
 #[derive(Clone)]
@@ -63,6 +85,8 @@ pub struct Mutant {
     extra: Vec<Output>,
     /// `SilentSetupWrite`: the next acknowledge is dropped.
     drop_ack: bool,
+    /// `ServoErrorNotLatched`: since when b70.5 has been 1.
+    servo_since: Option<Micros>,
 }
 
 impl Mutant {
@@ -83,6 +107,7 @@ impl Mutant {
             held: Vec::new(),
             extra: Vec::new(),
             drop_ack: false,
+            servo_since: None,
         }
     }
 
@@ -251,6 +276,53 @@ impl Mutant {
             {
                 self.drop_ack = true;
             }
+            (Kind::ReservedWriteStopsProfile, Some(Message::WriteParam { addr, par, .. }))
+                if addr == own
+                    && spec()
+                        .family(FamilyId::Hpd)
+                        .parameter("Pr66")
+                        .and_then(|p| p.address)
+                        == Some(u32::from(par)) =>
+            {
+                let family = spec().family(FamilyId::Hpd);
+                let busy = Target::parse(family, "b70.7").unwrap();
+                let running = self.inner.value(&busy).unwrap_or(0) != 0;
+                self.inner.handle_rx(now, bytes);
+                if running {
+                    let mode = Target::parse(family, "Pr31").unwrap();
+                    let _ = self.inner.set_value(now, &mode, 0);
+                }
+                return;
+            }
+            (Kind::EndNeedsZeroByte, Some(Message::WritePlc { addr, par, data }))
+                if addr == own =>
+            {
+                let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec()).unwrap();
+                let passed_over =
+                    codec
+                        .decode(data.as_slice(), usize::from(par))
+                        .is_ok_and(|(i, _)| {
+                            codec.is_end(&i)
+                                && matches!(
+                                    i.operands,
+                                    drivespec_hpd::plc::Operands::None { spare1, .. } if spare1 != 0
+                                )
+                        });
+                if passed_over {
+                    let mut ld = Vec::new();
+                    let program = codec.parse_listing("LD 99.13").unwrap();
+                    for (_, i) in &program.instrs {
+                        codec.encode(i, &mut ld).unwrap();
+                    }
+                    let m = Message::WritePlc {
+                        addr,
+                        par,
+                        data: Data::new(&ld).unwrap(),
+                    };
+                    self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                    return;
+                }
+            }
             (Kind::PlcWritableWhileRunning, Some(Message::WritePlc { addr, .. }))
                 if addr == own =>
             {
@@ -359,6 +431,48 @@ impl Mutant {
                 };
                 m.to_bytes(&self.rules).unwrap()
             }
+            (Kind::EnableStatusNeverSet, Message::Response { addr, par, data })
+                if spec()
+                    .family(FamilyId::Hpd)
+                    .parameter("Pb41")
+                    .and_then(|p| p.address)
+                    == Some(u32::from(par)) =>
+            {
+                let mut d = data.as_slice().to_vec();
+                if let Some(low) = d.first_mut() {
+                    *low &= !(1 << 5);
+                }
+                let m = Message::Response {
+                    addr,
+                    par,
+                    data: Data::new(&d).unwrap(),
+                };
+                m.to_bytes(&self.rules).unwrap()
+            }
+            (Kind::EnabledIgnoresSoftwareEnable, Message::Response { addr, par, data })
+                if spec()
+                    .family(FamilyId::Hpd)
+                    .parameter("Pb41")
+                    .and_then(|p| p.address)
+                    == Some(u32::from(par))
+                    && data.len() == 2 =>
+            {
+                let mut d = data.as_slice().to_vec();
+                let hardware = d.first().is_some_and(|low| low & (1 << 5) != 0);
+                if let Some(high) = d.get_mut(1) {
+                    *high = if hardware {
+                        *high | (1 << 4)
+                    } else {
+                        *high & !(1 << 4)
+                    };
+                }
+                let m = Message::Response {
+                    addr,
+                    par,
+                    data: Data::new(&d).unwrap(),
+                };
+                m.to_bytes(&self.rules).unwrap()
+            }
             (Kind::AckWithChecksum, Message::Ack { .. }) => {
                 let mut b = bytes.clone();
                 let chk = b.get(1).copied().unwrap_or(0);
@@ -393,6 +507,27 @@ impl SimDevice for Mutant {
         self.inner.advance(now);
         if self.kind == Kind::FinAnywhere {
             self.late_fins(now);
+        }
+        if self.kind == Kind::ServoErrorNotLatched && self.mode() == 9 {
+            let servo = Target::parse(spec().family(FamilyId::Hpd), "b70.5").unwrap();
+            if self.inner.value(&servo).unwrap_or(0) == 0 {
+                self.servo_since = None;
+            } else {
+                let since = *self.servo_since.get_or_insert(now);
+                if now.saturating_sub(since) >= SERVO_SLOT_US {
+                    let _ = self.inner.set_value(now, &servo, 0);
+                    self.servo_since = None;
+                }
+            }
+        }
+        if self.kind == Kind::TorqueBeyondPeak {
+            let family = spec().family(FamilyId::Hpd);
+            let speed = Target::parse(family, "Pr0").unwrap();
+            let torque = Target::parse(family, "Pr35").unwrap();
+            let turning = self.inner.value(&speed).unwrap_or(0) != 0;
+            let _ = self
+                .inner
+                .set_value(now, &torque, if turning { UNLIMITED_TORQUE } else { 0 });
         }
         if self.kind == Kind::FastTimer {
             let after = self.inner.value(&timer).unwrap_or(0);
@@ -600,7 +735,7 @@ pub fn mutants() -> Vec<Case> {
         Case {
             name: "digital inputs never read",
             kind: Kind::DeafInputs,
-            breaks: v(&["HPD-BIT-90-INPUTS"]),
+            breaks: v(&["HPD-BIT-90-INPUTS", "HPD-BIT-41-5", "HPD-BIT-41-12"]),
             must_fail: &[
                 "hpd/plc/vector/plc-ld-out",
                 "hpd/plc/vector/plc-default-limits-enabled-closed",
@@ -617,6 +752,45 @@ pub fn mutants() -> Vec<Case> {
             kind: Kind::AnswersLate,
             breaks: v(&["HPD-BAUD-004"]),
             must_fail: &["hpd/frame/read-parameter", "hpd/param/Pr33/min"],
+        },
+        Case {
+            name: "END with a non-zero second byte passed over",
+            kind: Kind::EndNeedsZeroByte,
+            breaks: v(&["HPD-PLC-043"]),
+            must_fail: &["hpd/plc/end-second-byte"],
+        },
+        Case {
+            name: "Pr35 beyond the peak while turning",
+            kind: Kind::TorqueBeyondPeak,
+            breaks: v(&["HPD-PAR-048"]),
+            must_fail: &[
+                "hpd/motion/mode-8/jog-forward",
+                "hpd/motion/mode-8/jog-reverse",
+            ],
+        },
+        Case {
+            name: "b41.5 never set",
+            kind: Kind::EnableStatusNeverSet,
+            breaks: v(&["HPD-BIT-41-5"]),
+            must_fail: &["hpd/bit/b41.5/hardware-enable"],
+        },
+        Case {
+            name: "b41.12 ignores b40.9",
+            kind: Kind::EnabledIgnoresSoftwareEnable,
+            breaks: v(&["HPD-BIT-41-12"]),
+            must_fail: &["hpd/bit/b41.12/drive-enabled"],
+        },
+        Case {
+            name: "Pr66 write stops a running profile",
+            kind: Kind::ReservedWriteStopsProfile,
+            breaks: v(&["HPD-MODE-9-008"]),
+            must_fail: &["hpd/motion/mode-9/reserved-while-busy"],
+        },
+        Case {
+            name: "b70.5 not latched in mode 9",
+            kind: Kind::ServoErrorNotLatched,
+            breaks: v(&["HPD-MODE-SERVO-ERROR-LATCH"]),
+            must_fail: &["hpd/motion/mode-9/servo-error-latched"],
         },
         Case {
             name: "command bits stay set",

@@ -777,6 +777,10 @@ pub struct Io {
     pub input_param: String,
     /// Parameter holding the outputs (Pb91).
     pub output_param: String,
+    /// Index of the hardware enable input (3.8.1 "b90.0 = drive enable", 3.2 X3-11).
+    pub enable_input: u8,
+    /// The software enable bit: with it 0 the drive cannot be started (3.3 b40.9).
+    pub software_enable_bit: String,
     /// The digital inputs, b90.0…7.
     pub inputs: Vec<IoPoint>,
     /// The digital outputs, b91.0…6.

@@ -2,12 +2,13 @@
 //! upload and read-back, command bits with their preconditions, every Pr26 code with its
 //! time-out, and the spec's golden vectors (manual 3.4, 3.8.1, 4, 4.1).
 
-use super::cases::{bit_value, sign_for, CaseB, Gen};
+use super::cases::{bit_value, sign_for, BitRef, CaseB, Gen};
 use super::names;
 use super::step::{Action, Compare, Step};
 use crate::case::Role;
 use drivespec_hpd::memory::Slot;
 use drivespec_hpd::params::Target;
+use drivespec_hpd::plc::Operands;
 use drivespec_hpd::{parse, Data, Message};
 use drivespec_spec::hex::parse_hex;
 use drivespec_spec::{Level, Vector, VectorKind, VectorResult};
@@ -22,6 +23,7 @@ pub(crate) fn generate(g: &mut Gen) {
     plc_vectors(g);
     timers(g);
     power_up(g);
+    hardware_enable(g);
 }
 
 /// Another address than the device's own, picked by the seed.
@@ -227,6 +229,74 @@ fn assemble(g: &Gen, lines: &[&str]) -> Option<Vec<u8>> {
     g.codec.encode_program(&program).ok()
 }
 
+/// The second byte given to END by `hpd/plc/end-second-byte`: any non-zero value, all bits
+/// set so that no bit of it may count (manual 4.1: "the second byte of END is not used").
+const END_SECOND_BYTE: u8 = 0xFF;
+
+/// A listing assembled to bytes, its first END carrying `second` in the byte 4.1 leaves
+/// unused.
+fn assemble_with_end_byte(g: &Gen, lines: &[&str], second: u8) -> Option<Vec<u8>> {
+    let text = lines.join("\n");
+    let mut program = g.codec.parse_listing(&text).ok()?;
+    let end = program
+        .instrs
+        .iter_mut()
+        .map(|(_, i)| i)
+        .find(|i| g.codec.is_end(i))?;
+    if let Operands::None { spare1, .. } = &mut end.operands {
+        *spare1 = second;
+    }
+    g.codec.encode_program(&program).ok()
+}
+
+/// Steps of a case that uploads `program` with the PLC stopped and `flag` cleared, starts
+/// the PLC and reads `flag` after three scans (set by the program), then restores the PLC
+/// area, the flag and Pb99; the read checks `requirement` first, when given.
+fn run_program(
+    g: &mut Gen,
+    cb: &mut CaseB,
+    program: &[u8],
+    flag: &BitRef,
+    requirement: Option<&str>,
+) {
+    let first = g.protocol.plc.first_address;
+    let original = plc_base(g, usize::from(first), program.len());
+    let scan = u64::from(g.protocol.plc.scan_us);
+    g.stop_plc(cb);
+    g.bit(cb, Role::Setup, flag, false);
+    upload(g, cb, Role::Setup, first, program);
+    let run = g.run;
+    let start = g.base(run.0);
+    g.write(
+        cb,
+        Role::Setup,
+        run.0,
+        i64::from(start),
+        "Pb99 (PLC running)",
+    );
+    cb.action(
+        Role::Check,
+        Action::Listen { us: 3 * scan },
+        "listen for three PLC scans",
+        &["HPD-PLC-004"],
+    );
+    let cmp = match g.compare_for(flag.param, None) {
+        Compare::Mask(m) => Compare::Mask(m | bit_value(flag.slot, flag.at)),
+        c => c,
+    };
+    g.read(cb, Role::Check, flag.slot, cmp, "Pb90");
+    if let (Some(r), Some(step)) = (requirement, cb.steps.last_mut()) {
+        step.requirements.insert(0, r.to_owned());
+    }
+    g.stop_plc(cb);
+    if let Some(s) = cb.steps.last_mut() {
+        s.role = Role::Cleanup;
+    }
+    upload(g, cb, Role::Cleanup, first, &original);
+    g.restore(cb, flag.slot, "Pb90");
+    g.restore_pb99(cb);
+}
+
 fn plc(g: &mut Gen) {
     let own = g.addr;
     let area = usize::from(g.protocol.plc.area_bytes);
@@ -345,7 +415,6 @@ fn plc(g: &mut Gen) {
     g.restore_pb99(&mut cb);
     g.push(cb);
 
-    let scan = u64::from(g.protocol.plc.scan_us);
     let mut cb = CaseB::new(
         "hpd/plc/run",
         format!(
@@ -354,37 +423,33 @@ fn plc(g: &mut Gen) {
         ),
         &["HPD-BIT-99-13", "HPD-PLC-004", "HPD-PLC-009", "HPD-PLC-011"],
     );
-    g.stop_plc(&mut cb);
-    g.bit(&mut cb, Role::Setup, &flag_ref, false);
-    upload(g, &mut cb, Role::Setup, first, &program);
-    let run = g.run;
-    let start = g.base(run.0);
-    g.write(
-        &mut cb,
-        Role::Setup,
-        run.0,
-        i64::from(start),
-        "Pb99 (PLC running)",
-    );
-    cb.action(
-        Role::Check,
-        Action::Listen { us: 3 * scan },
-        "listen for three PLC scans",
-        &["HPD-PLC-004"],
-    );
-    let cmp = g.compare_for(flag_ref.param, None);
-    let cmp = match cmp {
-        Compare::Mask(m) => Compare::Mask(m | bit_value(flag_ref.slot, flag_ref.at)),
-        c => c,
+    run_program(g, &mut cb, &program, &flag_ref, None);
+    g.push(cb);
+
+    // HPD-PLC-043: END with a non-zero second byte still ends the program; the
+    // instructions behind it would clear the flag again.
+    let mut lines = lines.to_vec();
+    lines.extend([
+        format!("LD {run_bit}"),
+        format!("OUTN {flag_num}"),
+        "END".to_owned(),
+    ]);
+    let line_refs: Vec<&str> = lines.iter().map(String::as_str).collect();
+    let Some(program) = assemble_with_end_byte(g, &line_refs, END_SECOND_BYTE) else {
+        g.errors
+            .push("hpd/plc: the END test program does not assemble".to_owned());
+        return;
     };
-    g.read(&mut cb, Role::Check, flag_ref.slot, cmp, "Pb90");
-    g.stop_plc(&mut cb);
-    if let Some(s) = cb.steps.last_mut() {
-        s.role = Role::Cleanup;
-    }
-    upload(g, &mut cb, Role::Cleanup, first, &original);
-    g.restore(&mut cb, flag_ref.slot, "Pb90");
-    g.restore_pb99(&mut cb);
+    let mut cb = CaseB::new(
+        "hpd/plc/end-second-byte",
+        format!(
+            "`{}` with {END_SECOND_BYTE:#04x} in the second byte of the first END: the \
+             program ends there and {flag} stays set",
+            lines.join("; ")
+        ),
+        &["HPD-PLC-043"],
+    );
+    run_program(g, &mut cb, &program, &flag_ref, Some("HPD-PLC-043"));
     g.push(cb);
 }
 
@@ -1393,5 +1458,104 @@ fn power_up(g: &mut Gen) {
     );
     g.restore(&mut cb, flag.slot, "Pb90");
     g.bit(&mut cb, Role::Cleanup, &save_ref, true);
+    g.push(cb);
+}
+
+/// HPD-BIT-41-5 and HPD-BIT-41-12 (manual 3.3 b41.5, b41.12, b40.9; 3.8.1 "b90.0 = drive
+/// enable"): b41.5 shows the hardware enable input; b41.12 is 1 with the input applied and
+/// b40.9 = 1, and 0 with either withdrawn. The manual does not say which task of appendix F
+/// updates them; each read waits two periods of the slowest task slot, which covers every
+/// slot.
+fn hardware_enable(g: &mut Gen) {
+    let io = &g.protocol.io;
+    let (Some(enable), Some(status), Some(enabled), Some(software)) = (
+        io.inputs
+            .iter()
+            .find(|i| i.index == io.enable_input)
+            .map(|i| i.bit.clone()),
+        g.bit_ref(names::HARDWARE_ENABLE),
+        g.bit_ref(names::DRIVE_ENABLED),
+        g.bit_ref(&io.software_enable_bit),
+    ) else {
+        return;
+    };
+    let Some(mask) = 1u16.checked_shl(u32::from(io.enable_input)) else {
+        return;
+    };
+    let sw = io.software_enable_bit.clone();
+    let wait = 2 * g
+        .protocol
+        .task_slots
+        .iter()
+        .map(|s| u64::from(s.period_us))
+        .max()
+        .unwrap_or(u64::from(g.protocol.plc.scan_us));
+    let start = g.baseline.digital_inputs();
+    let inputs = |cb: &mut CaseB, value: u16, what: &str| {
+        cb.action(
+            Role::Setup,
+            Action::Inputs { value },
+            format!("hardware enable input {enable} {what}: inputs {value:#06x}"),
+            &[],
+        );
+    };
+    // Waits, then reads `bit` (only it compared) checking `requirement`.
+    let read = |g: &mut Gen, cb: &mut CaseB, bit: &BitRef, requirement: &str| {
+        cb.action(
+            Role::Setup,
+            Action::Listen { us: wait },
+            "listen for two periods of the slowest task slot",
+            &[],
+        );
+        let cmp = Compare::Mask(bit_value(bit.slot, bit.at));
+        g.read(cb, Role::Check, bit.slot, cmp, bit.param.id.as_str());
+        if let Some(step) = cb.steps.last_mut() {
+            step.requirements.insert(0, requirement.to_owned());
+        }
+    };
+
+    let mut cb = CaseB::new(
+        "hpd/bit/b41.5/hardware-enable",
+        format!(
+            "{} follows the hardware enable input {enable}: 1 with the input applied, 0 with it removed",
+            names::HARDWARE_ENABLE
+        ),
+        &["HPD-BIT-41-5"],
+    );
+    for (value, what) in [(start | mask, "applied"), (start & !mask, "removed")] {
+        inputs(&mut cb, value, what);
+        read(g, &mut cb, &status, "HPD-BIT-41-5");
+    }
+    cb.action(
+        Role::Cleanup,
+        Action::Inputs { value: start },
+        "the digital inputs as at the start",
+        &[],
+    );
+    g.push(cb);
+
+    let mut cb = CaseB::new(
+        "hpd/bit/b41.12/drive-enabled",
+        format!(
+            "{} is 1 with the hardware enable input {enable} applied and {sw} = 1, 0 after {sw} = 0, and 0 with {sw} = 1 and the input removed",
+            names::DRIVE_ENABLED
+        ),
+        &["HPD-BIT-41-12"],
+    );
+    g.bit(&mut cb, Role::Setup, &software, true);
+    inputs(&mut cb, start | mask, "applied");
+    read(g, &mut cb, &enabled, "HPD-BIT-41-12");
+    g.bit(&mut cb, Role::Setup, &software, false);
+    read(g, &mut cb, &enabled, "HPD-BIT-41-12");
+    g.bit(&mut cb, Role::Setup, &software, true);
+    inputs(&mut cb, start & !mask, "removed");
+    read(g, &mut cb, &enabled, "HPD-BIT-41-12");
+    cb.action(
+        Role::Cleanup,
+        Action::Inputs { value: start },
+        "the digital inputs as at the start",
+        &[],
+    );
+    g.restore(&mut cb, software.slot, software.param.id.as_str());
     g.push(cb);
 }

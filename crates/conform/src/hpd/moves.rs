@@ -60,6 +60,9 @@ const WINDOW: (i64, i64) = (700, 400);
 const INTERNAL_RPM: i64 = 250;
 /// Spindle orientation speed Pr50 (rpm).
 const ORIENT_RPM: i64 = 200;
+/// Pr35 is in % of the drive's peak (manual 3.3): the torque a drive delivers is at most its
+/// peak, 100 % either way.
+const PEAK_PERCENT: f64 = 100.0;
 /// Positioning profile: Pr51 (ms per 1000 rpm), Pr52 (rpm), revolutions.
 const PROFILE: (i64, i64, i64) = (200, 600, 5);
 
@@ -76,7 +79,9 @@ pub(crate) fn generate(g: &mut Gen) {
     positioning(g, &m, false);
     positioning(g, &m, true);
     locked_while_busy(g, &m);
+    reserved_while_busy(g, &m);
     clear_increment(g, &m);
+    servo_error_latch(g, &m);
     wiring_test(g, &m);
     feed_forward_defaults(g, &m);
     resets(g, &m);
@@ -95,6 +100,9 @@ struct Motion {
     reference: Probe,
     flags41: Probe,
     flags70: Probe,
+    torque: Probe,
+    /// Pr35's raw value at the drive's peak torque.
+    peak: i64,
     slots: Vec<(u8, Slot)>,
     bit_lag_us: u64,
     /// The drive's slow operating-mode slot (µs): a drive may change its speed and position
@@ -114,7 +122,7 @@ impl Motion {
             })
         };
         let slots = [
-            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 54, 56, 57, 64,
+            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 54, 56, 57, 64, 66,
         ]
         .iter()
         .map(|n| Some((*n, g.slot_of(&format!("Pr{n}"))?)))
@@ -140,6 +148,8 @@ impl Motion {
             reference: probe("Pr60", Some(4))?,
             flags41: probe("Pb41", None)?,
             flags70: probe("Pb70", None)?,
+            torque: probe(names::TORQUE_MONITOR, None)?,
+            peak: peak_raw(g.param(names::TORQUE_MONITOR)?.scale?),
             slots,
             bit_lag_us: u64::from(lag.period_us) + BIT_LAG_SLACK_US,
             slot_us: u64::from(slot.period_us),
@@ -168,6 +178,16 @@ impl Motion {
             .iter()
             .find(|(k, _)| *k == n)
             .map_or(Slot { addr: 0, size: 0 }, |(_, s)| *s)
+    }
+}
+
+/// The raw value of [`PEAK_PERCENT`] in steps of `scale` %.
+fn peak_raw(scale: f64) -> i64 {
+    let steps = (PEAK_PERCENT / scale).round();
+    if steps.is_finite() && steps.abs() < 1e15 {
+        steps as i64
+    } else {
+        0
     }
 }
 
@@ -315,7 +335,7 @@ fn pb40_with(g: &Gen, m: &Motion, bits: &[&str]) -> i64 {
 }
 
 /// HPD-MODE-8-001: jog with b70.1 (forward) or b70.2 (reverse) at Pr50, on the Pr8..Pr11
-/// ramps, then back to standstill.
+/// ramps, then back to standstill; HPD-PAR-048: Pr35 within ± the peak while it turns.
 fn jog(g: &mut Gen, m: &Motion, forward: bool) {
     let (name, jog_bit, up, down) = if forward {
         ("forward", "b70.1", m.pr(8), m.pr(9))
@@ -334,7 +354,7 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
     let mut cb = CaseB::new(
         format!("hpd/motion/mode-8/jog-{name}"),
         format!(
-            "mode 8 with b40.2 = 1: {jog_bit} turns the shaft {name} at Pr50 = {JOG_RPM} rpm on the ramps, and back to 0 rpm when cleared; b41.0–b41.3 follow the speed"
+            "mode 8 with b40.2 = 1: {jog_bit} turns the shaft {name} at Pr50 = {JOG_RPM} rpm on the ramps, and back to 0 rpm when cleared; b41.0–b41.3 follow the speed; Pr35 stays within the drive's peak while it turns"
         ),
         &[],
     );
@@ -408,6 +428,21 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
             target + SPEED_SLACK_RPM,
         )],
         checks,
+    );
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr0 and Pr35 while the shaft turns at {target} rpm"),
+        vec![m.speed, m.torque],
+        HOLD_US,
+        Vec::new(),
+        vec![check(
+            "HPD-PAR-048",
+            Envelope::Bounded {
+                within: within(1, -m.peak, m.peak),
+            },
+        )],
     );
     g.bit(&mut cb, Role::Check, &bit, false);
     let mut checks = vec![
@@ -825,6 +860,115 @@ fn locked_while_busy(g: &mut Gen, m: &Motion) {
     g.push(cb);
 }
 
+/// HPD-MODE-9-008: Pr66:67 is reserved while a profile is generated (manual 3.6.4: "cannot
+/// be used during profile generation"). The manual does not say what a write of it then
+/// does: its answer (acknowledge or silence) and the value read back are each accepted and
+/// reported. 3.6.4 allows no change of a running profile but of Pr64:65: the write, made at
+/// the cruise speed, leaves the shaft at that speed, and the profile ends at its target
+/// (HPD-MODE-9-001).
+fn reserved_while_busy(g: &mut Gen, m: &Motion) {
+    let (accel, top, _) = PROFILE;
+    let steps = 6 * STEPS_PER_REV;
+    let slow = top / 2;
+    let window = 100;
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-9/reserved-while-busy",
+        format!(
+            "mode 9: a write of Pr66:67 while a profile of {steps} steps at {slow} rpm executes may be taken, refused or ignored; the profile still ends within Pr56 of its target"
+        ),
+        &[],
+    );
+    let values = [
+        (m.pr(51), accel, "Pr51"),
+        (m.pr(52), slow, "Pr52"),
+        (m.pr(56), window, "Pr56"),
+    ];
+    setup(g, &mut cb, m, 9, &values);
+    let increment = Slot {
+        addr: m.pr(64).addr,
+        size: 4,
+    };
+    let reserved = Slot {
+        addr: m.pr(66).addr,
+        size: 4,
+    };
+    g.write(&mut cb, Role::Setup, increment, steps, "Pr64:65");
+    let pb40 = pb40_with(g, m, &[names::RESERVED_REFERENCE]);
+    g.write(&mut cb, Role::Setup, m.pb40, pb40, "Pb40 (b40.2 = 1)");
+    command(g, &mut cb, Role::Setup, "b70.10");
+    command(g, &mut cb, Role::Setup, "b70.8");
+    let cruise = within(0, slow - SPEED_SLACK_RPM, slow + SPEED_SLACK_RPM);
+    watch(
+        g,
+        &mut cb,
+        Role::Setup,
+        &format!("wait until Pr0 = {slow} rpm"),
+        vec![m.speed],
+        time_bound(slow, accel),
+        vec![cruise],
+        Vec::new(),
+    );
+    if let Some(step) = cb.steps.last_mut() {
+        if let Action::Watch { hold_us, .. } = &mut step.action {
+            *hold_us = 0;
+        }
+    }
+    g.write(
+        &mut cb,
+        Role::Check,
+        reserved,
+        steps,
+        "Pr66:67 (while the profile runs)",
+    );
+    if let Some(step) = cb.steps.last_mut() {
+        step.requirements.insert(0, "HPD-MODE-9-008".to_owned());
+        if let Action::Exchange { silence_ok, .. } = &mut step.action {
+            *silence_ok = true;
+        }
+    }
+    g.read_open(
+        &mut cb,
+        reserved,
+        (0, i64::from(i32::MIN), i64::from(i32::MAX)),
+        "HPD-MODE-9-008",
+        "Pr66:67",
+    );
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr0 at {slow} rpm after the write"),
+        vec![m.speed],
+        HOLD_US,
+        Vec::new(),
+        vec![check(
+            "HPD-MODE-9-008",
+            Envelope::Bounded { within: cruise },
+        )],
+    );
+    let ideal_us = u64::try_from(steps * 60_000_000 / STEPS_PER_REV / slow).unwrap_or(0);
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        &format!("watch Pr62:63 and Pb70 until b70.7 = 0 at {steps}"),
+        vec![m.position, m.flags70],
+        ideal_us * TIME_FACTOR_PERCENT / 100 + TIME_EXTRA_US,
+        vec![bit_is(1, 7, 0), within(0, steps - window, steps + window)],
+        vec![check(
+            "HPD-MODE-9-001",
+            Envelope::Ends {
+                within: within(0, steps - window, steps + window),
+            },
+        )],
+    );
+    command(g, &mut cb, Role::Cleanup, "b70.10");
+    g.restore(&mut cb, reserved, "Pr66:67");
+    g.restore(&mut cb, increment, "Pr64:65");
+    cleanup(g, &mut cb, m, &values);
+    g.push(cb);
+}
+
 /// HPD-MODE-9-005: b70.2 clears Pr64:65 in mode 9.
 fn clear_increment(g: &mut Gen, m: &Motion) {
     let mut cb = CaseB::new(
@@ -844,6 +988,46 @@ fn clear_increment(g: &mut Gen, m: &Motion) {
         step.requirements.insert(0, "HPD-MODE-9-005".to_owned());
     }
     g.restore(&mut cb, increment, "Pr64:65");
+    g.restore(&mut cb, m.pb70, "Pb70");
+    g.restore(&mut cb, m.mode, "Pr31");
+    g.restore_pb99(&mut cb);
+    g.push(cb);
+}
+
+/// HPD-MODE-SERVO-ERROR-LATCH: in mode 9 b70.5, once 1, stays 1 until the user resets it
+/// (manual 3.6.4: "If b70.5 is utilised it must be reset by the user"). Set over the line at
+/// standstill, it is still 1 after two periods of the slowest task slot (appendix F), however
+/// the position error then compares with Pr56.
+fn servo_error_latch(g: &mut Gen, m: &Motion) {
+    let Some(servo) = g.bit_ref("b70.5") else {
+        return;
+    };
+    let wait = 2 * g
+        .protocol
+        .task_slots
+        .iter()
+        .map(|s| u64::from(s.period_us))
+        .max()
+        .unwrap_or(m.slot_us);
+    let mut cb = CaseB::new(
+        "hpd/motion/mode-9/servo-error-latched",
+        "mode 9: b70.5 set over the line stays 1 until the user clears it",
+        &[],
+    );
+    setup(g, &mut cb, m, 9, &[]);
+    g.bit(&mut cb, Role::Setup, &servo, true);
+    cb.action(
+        Role::Setup,
+        Action::Listen { us: wait },
+        "listen for two periods of the slowest task slot",
+        &[],
+    );
+    let cmp = Compare::Mask(bit_value(m.pb70, servo.at));
+    g.read(&mut cb, Role::Check, m.pb70, cmp, "Pb70");
+    if let Some(step) = cb.steps.last_mut() {
+        step.requirements
+            .insert(0, "HPD-MODE-SERVO-ERROR-LATCH".to_owned());
+    }
     g.restore(&mut cb, m.pb70, "Pb70");
     g.restore(&mut cb, m.mode, "Pr31");
     g.restore_pb99(&mut cb);

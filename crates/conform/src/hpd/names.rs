@@ -26,6 +26,12 @@ pub const RANGED: &str = "Pr33";
 pub const READ_ONLY: &str = "Pr25";
 /// A saved parameter with a delivery value (manual 3.3 Pr2).
 pub const WITH_DEFAULT: &str = "Pr2";
+/// The torque monitor, in % of the drive's peak (manual 3.3 Pr35).
+pub const TORQUE_MONITOR: &str = "Pr35";
+/// The hardware enable status bit (manual 3.3 b41.5).
+pub const HARDWARE_ENABLE: &str = "b41.5";
+/// The drive enabled bit (manual 3.3 b41.12).
+pub const DRIVE_ENABLED: &str = "b41.12";
 /// A user flag bit (manual 3.8.1 b90.8).
 pub const USER_FLAG: &str = "b90.8";
 /// Another saved user flag, kept by the parameter save (manual 3.8.1 b90.8..b90.15).

@@ -167,11 +167,21 @@ impl Drive {
     }
 
     /// Status the model keeps: HPD-BIT-41-4, drive healthy while no alarm is active (the DC
-    /// bus is taken as ready).
+    /// bus is taken as ready); HPD-BIT-41-5, the hardware enable input as last read;
+    /// HPD-BIT-41-12, the drive enabled by the hardware enable and b40.9 with no alarm.
     pub(super) fn refresh_status(&mut self) {
-        if let Some(b) = self.layout.named.healthy {
-            let healthy = self.alarms().active == 0;
-            self.working.set_bit(b, healthy);
+        let named = &self.layout.named;
+        let healthy = self.alarms().active == 0;
+        let hardware = self.inputs & named.enable_input != 0;
+        let enabled = hardware && healthy && self.working.bit(named.software_enable);
+        for (b, value) in [
+            (named.healthy, healthy),
+            (named.hardware_enable, hardware),
+            (named.drive_enabled, enabled),
+        ] {
+            if let Some(b) = b {
+                self.working.set_bit(b, value);
+            }
         }
         self.refresh_motor_status();
     }

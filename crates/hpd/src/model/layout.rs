@@ -111,6 +111,14 @@ pub(super) struct Named {
     pub(super) reserved_reference: BitAddr,
     pub(super) idc_trigger: BitAddr,
     pub(super) healthy: Option<BitAddr>,
+    /// The hardware enable status bit (b41.5).
+    pub(super) hardware_enable: Option<BitAddr>,
+    /// The drive enabled bit (b41.12).
+    pub(super) drive_enabled: Option<BitAddr>,
+    /// The hardware enable input, as a mask of the inputs.
+    pub(super) enable_input: u16,
+    /// The software enable bit (b40.9).
+    pub(super) software_enable: BitAddr,
     pub(super) baud: Slot,
     pub(super) address: Slot,
     pub(super) alarm: Slot,
@@ -242,6 +250,12 @@ impl Layout {
             reserved_reference: bit(&protocol.commands.mode_defaults_requires_clear)?,
             idc_trigger: bit(&protocol.idc.trigger_bit)?,
             healthy: None,
+            hardware_enable: None,
+            drive_enabled: None,
+            enable_input: 1u16
+                .checked_shl(u32::from(protocol.io.enable_input))
+                .unwrap_or(0),
+            software_enable: bit(&protocol.io.software_enable_bit)?,
             baud: slot(&setup_spec.baud_param)?,
             address: slot(&setup_spec.address_param)?,
             alarm: slot(&protocol.commands.alarm_param)?,
@@ -276,6 +290,8 @@ impl Layout {
         let mut commands = Vec::new();
         let mut power_on_reset = Vec::new();
         let mut healthy = None;
+        let mut hardware_enable = None;
+        let mut drive_enabled = None;
         for bf in &family.bitfields {
             let Some(p) = family.parameter(&bf.param) else {
                 continue;
@@ -317,6 +333,12 @@ impl Layout {
                         }
                         (names::TRIGGER_POWER_ON, RuleAction::Reset) => power_on_reset.push(addr),
                         (names::TRIGGER_ALARM_RAISED, RuleAction::Reset) => healthy = Some(addr),
+                        (names::TRIGGER_HARDWARE_ENABLE, RuleAction::Set) => {
+                            hardware_enable = Some(addr);
+                        }
+                        (names::TRIGGER_DRIVE_ENABLED, RuleAction::Set) => {
+                            drive_enabled = Some(addr);
+                        }
                         _ => {}
                     }
                 }
@@ -330,7 +352,12 @@ impl Layout {
                 )));
             }
         }
-        let named = Named { healthy, ..named };
+        let named = Named {
+            healthy,
+            hardware_enable,
+            drive_enabled,
+            ..named
+        };
 
         let mut saved_mask = [0u8; 256];
         let mut factory = Memory::default();

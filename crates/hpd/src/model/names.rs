@@ -7,6 +7,10 @@ pub(super) const TRIGGER_COMMAND: &str = "command-executed";
 pub(super) const TRIGGER_POWER_ON: &str = "power-on";
 /// Bit-rule trigger that clears the drive-healthy bit (bits.toml, b41.4).
 pub(super) const TRIGGER_ALARM_RAISED: &str = "alarm-raised";
+/// Bit-rule trigger that sets the hardware enable status bit (bits.toml, b41.5).
+pub(super) const TRIGGER_HARDWARE_ENABLE: &str = "hardware-enable-on";
+/// Bit-rule trigger that sets the drive enabled bit (bits.toml, b41.12).
+pub(super) const TRIGGER_DRIVE_ENABLED: &str = "drive-enabled";
 
 /// Erratum option: do command bits clear themselves (HPD-ERRATUM-012).
 pub(super) const OPTION_SELF_CLEAR: &str = "command-self-clear";
