@@ -174,6 +174,41 @@ pub(crate) fn env_op<O>(t: u64, env: &str) -> Op<O> {
     )
 }
 
+/// The requirements of status bit `bit`'s rules (spec bitfield `status`), each once: those
+/// that make it `to` first (set rules for `Some(true)`, reset rules for `Some(false)`).
+pub(crate) fn status_bit_rules(family: &Family, bit: u32, to: Option<bool>) -> Vec<String> {
+    let Some(b) = family
+        .bitfield("status")
+        .and_then(|f| f.bits.iter().find(|x| x.bit == bit))
+    else {
+        return Vec::new();
+    };
+    let wanted = match to {
+        Some(true) => Some(RuleAction::Set),
+        Some(false) => Some(RuleAction::Reset),
+        None => None,
+    };
+    let first = b
+        .rules
+        .iter()
+        .filter(|r| Some(r.action) == wanted)
+        .map(|r| r.requirement.clone())
+        .collect();
+    let rest: Vec<String> = b.rules.iter().map(|r| r.requirement.clone()).collect();
+    merged(first, &rest)
+}
+
+/// `first`, then `rest`, each requirement once, in that order.
+pub(crate) fn merged(first: Vec<String>, rest: &[String]) -> Vec<String> {
+    let mut ids: Vec<String> = Vec::new();
+    for id in first.into_iter().chain(rest.iter().cloned()) {
+        if !ids.contains(&id) {
+            ids.push(id);
+        }
+    }
+    ids
+}
+
 /// `req` with its time set to `t` (requests without a time unchanged).
 fn at_time(req: &Request, t: u64) -> Request {
     let mut req = req.clone();
@@ -1326,7 +1361,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                             step_of(&run.cycles, x.theirs)
                         ),
                     )
-                    .breaking(self.bit_rules(bit, x.reference.or(x.device)))
+                    .breaking(status_bit_rules(self.family.spec(), u32::from(bit), x.reference.or(x.device)))
                     // One side makes a change the other does not make at all while both
                     // move alike: the bit's own rule. Where the motion differs too, the bit
                     // follows it and the case's requirements lead.
@@ -1610,41 +1645,11 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 _ => acc,
             });
             for bit in (0..16u16).filter(|b| changed & (1 << b) != 0) {
-                for id in self.bit_rules(bit, None) {
+                for id in status_bit_rules(self.family.spec(), u32::from(bit), None) {
                     if !ids.contains(&id) {
                         ids.push(id);
                     }
                 }
-            }
-        }
-        ids
-    }
-
-    /// The requirements of status bit `bit`'s rules (spec bitfield `status`): those that make
-    /// it `to` first (set rules for `Some(true)`, reset rules for `Some(false)`).
-    fn bit_rules(&self, bit: u16, to: Option<bool>) -> Vec<String> {
-        let Some(b) = self
-            .family
-            .spec()
-            .bitfield("status")
-            .and_then(|f| f.bits.iter().find(|x| x.bit == u32::from(bit)))
-        else {
-            return Vec::new();
-        };
-        let wanted = match to {
-            Some(true) => Some(RuleAction::Set),
-            Some(false) => Some(RuleAction::Reset),
-            None => None,
-        };
-        let mut ids: Vec<String> = b
-            .rules
-            .iter()
-            .filter(|r| Some(r.action) == wanted)
-            .map(|r| r.requirement.clone())
-            .collect();
-        for r in &b.rules {
-            if !ids.contains(&r.requirement) {
-                ids.push(r.requirement.clone());
             }
         }
         ids

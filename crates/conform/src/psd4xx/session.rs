@@ -5,7 +5,9 @@ use super::cases::{status_bit, OpenPoint, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{CaseInfo, Finding};
 use crate::cyclic::{Env, Reply, Request, Server};
-use crate::cyclic_session::{env_op, same_length, CyclicFamily, CyclicSession, Op, Tolerance};
+use crate::cyclic_session::{
+    env_op, merged, same_length, CyclicFamily, CyclicSession, Op, Tolerance,
+};
 use drivespec_psd4xx::pkw::Reply as PkwReply;
 use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::{Input, Output, PkwRequest, PkwResponse};
@@ -355,13 +357,7 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
             }
             _ => None,
         };
-        let mut ids: Vec<String> = length.into_iter().collect();
-        for c in case {
-            if !ids.contains(c) {
-                ids.push(c.clone());
-            }
-        }
-        ids
+        merged(length.into_iter().collect(), case)
     }
 
     /// Records and injections are exact.

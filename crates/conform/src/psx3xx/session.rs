@@ -6,7 +6,8 @@ use super::Psx3xxSuite;
 use crate::case::CaseInfo;
 use crate::cyclic::{Env, Reply, Request, Server};
 use crate::cyclic_session::{
-    env_op, same_length, CyclicFamily, CyclicSession, Live, Op, OpenPoint, Tolerance,
+    env_op, merged, same_length, status_bit_rules, CyclicFamily, CyclicSession, Live, Op,
+    OpenPoint, Tolerance,
 };
 use drivespec_psd4xx::model::LinkEvent as BusEvent;
 use drivespec_psx3xx::isdu::ErrorType;
@@ -14,7 +15,7 @@ use drivespec_psx3xx::model::LinkEvent;
 use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Input, Output, Stamp, TsCode};
 use drivespec_spec::psx3xx::IsduErrorCase;
-use drivespec_spec::{DataType, Family, FamilyId, Parameter, RuleAction};
+use drivespec_spec::{DataType, Family, FamilyId, Parameter};
 
 /// A session on one device under test.
 pub type Psx3xxSession<'a, 's> = CyclicSession<'a, Psx3xx<'a, 's>>;
@@ -45,9 +46,6 @@ const TIME_STAMP: &str = "PSX-TS-";
 
 /// The status bit the runner waits on (manual 3.4 bit 6).
 const RUNNING: &str = "Drive is running";
-
-/// The bitfield of the status word (3.4).
-const STATUS: &str = "status";
 
 impl<'a, 's> Psx3xx<'a, 's> {
     /// The family of `suite`.
@@ -157,26 +155,6 @@ impl<'a, 's> Psx3xx<'a, 's> {
         }
         ids.extend(situation.requirement.clone());
         ids
-    }
-
-    /// The rules of status bit `bit` (3.4), those that make it `set` first.
-    fn status_rules(&self, bit: u32, set: bool) -> Vec<String> {
-        let Some(b) = self
-            .suite
-            .family()
-            .bitfield(STATUS)
-            .and_then(|f| f.bits.iter().find(|x| x.bit == bit))
-        else {
-            return Vec::new();
-        };
-        let wanted = if set {
-            RuleAction::Set
-        } else {
-            RuleAction::Reset
-        };
-        let (mut first, rest): (Vec<_>, Vec<_>) = b.rules.iter().partition(|r| r.action == wanted);
-        first.extend(rest);
-        first.into_iter().map(|r| r.requirement.clone()).collect()
     }
 
     /// Whether the device's reply is the reference's exactly, or for an ISDU error the same
@@ -337,7 +315,11 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
                 }
                 let differ = d.status ^ reference.status;
                 for bit in (0..16u32).filter(|b| differ & (1 << b) != 0) {
-                    ids.extend(self.status_rules(bit, reference.status & (1 << bit) != 0));
+                    ids.extend(status_bit_rules(
+                        self.suite.family(),
+                        bit,
+                        Some(reference.status & (1 << bit) != 0),
+                    ));
                 }
             }
             ids.extend(speed_cited(out, d, reference));
@@ -567,17 +549,6 @@ fn speed_cited(out: &Output, dut: &Input, reference: &Input) -> Option<String> {
         }
         .to_owned()
     })
-}
-
-/// `first`, then `rest`, each requirement once.
-fn merged(first: Vec<String>, rest: &[String]) -> Vec<String> {
-    let mut ids: Vec<String> = Vec::new();
-    for id in first.into_iter().chain(rest.iter().cloned()) {
-        if !ids.contains(&id) {
-            ids.push(id);
-        }
-    }
-    ids
 }
 
 /// `out` with the control word, target and target speed a `process` step gives (absent:
