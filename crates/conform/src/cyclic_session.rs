@@ -385,6 +385,17 @@ pub trait CyclicFamily<'s> {
 /// not one that differs from the reference's shape.
 const RAMP_SLACK_PERCENT: i64 = 50;
 
+/// The highest speed (rpm) an image taken `late_us` after its request may show: `limit`,
+/// plus the speed-up of `ramp_per_cycle` rpm a cycle (and [`RAMP_SLACK_PERCENT`]) for every
+/// cycle of `cycle_us` begun in the delay.
+fn speed_allowed(limit: i64, ramp_per_cycle: i64, late_us: u64, cycle_us: u64) -> i64 {
+    let cycles = late_us.div_ceil(cycle_us.max(1));
+    let ramp = ramp_per_cycle
+        .saturating_mul(100 + RAMP_SLACK_PERCENT)
+        .saturating_div(100);
+    limit.saturating_add(ramp.saturating_mul(i64::try_from(cycles).unwrap_or(i64::MAX)))
+}
+
 /// The steepest speed-up and slow-down per cycle (rpm) of a run's speeds (each with the
 /// time of its request and the time it was taken), a sign change counted as slowing to 0
 /// and speeding up from it.
@@ -1511,21 +1522,41 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             .saturating_mul(100 + SPEED_SLACK_PERCENT)
             .saturating_div(100)
             .saturating_add(tol.speed);
+        let cruise = speeds.iter().filter(|v| **v == top).count();
+        // Where the reference never cruised, the case ended before the speed in force was
+        // reached: an image taken later than its request may show the speed further up the
+        // ramp, by the steepest speed-up in force over the delay.
+        let ramp_per_cycle = if cruise >= CRUISE_CYCLES {
+            0
+        } else {
+            steepest(
+                run.cycles
+                    .iter()
+                    .map(|c| Some((F::motion(&c.reference).1, c.t, c.t))),
+            )
+            .0
+        };
+        let cycle_us = self.family.cycle_us();
         let device_top = run
             .cycles
             .iter()
             .enumerate()
             .filter_map(|(i, c)| c.dut.as_ref().ok().map(|d| (i, F::motion(d).1.abs())))
             .max_by_key(|(_, v)| *v);
-        if let Some((i, v)) = device_top.filter(|(_, v)| *v > limit) {
+        let too_fast = run.cycles.iter().enumerate().find_map(|(i, c)| {
+            let v = F::motion(c.dut.as_ref().ok()?).1.abs();
+            let allowed =
+                speed_allowed(limit, ramp_per_cycle, c.taken.saturating_sub(c.t), cycle_us);
+            (v > allowed).then_some((i, v, allowed))
+        });
+        if let Some((i, v, allowed)) = too_fast {
             bad.push(Finding::at(
                 i,
                 run.cycles.get(i).map_or(0, |c| c.step),
                 None,
-                format!("speed {v} rpm is above the highest allowed, {limit} rpm"),
+                format!("speed {v} rpm is above the highest allowed, {allowed} rpm"),
             ));
         }
-        let cruise = speeds.iter().filter(|v| **v == top).count();
         let floor = top
             .saturating_mul(100 - SPEED_SLACK_PERCENT)
             .saturating_div(100)
@@ -1839,7 +1870,20 @@ impl<'s, F: CyclicFamily<'s>> Session for CyclicSession<'_, F> {
 
 #[cfg(test)]
 mod tests {
-    use super::{reversal_stops, steepest};
+    use super::{reversal_stops, speed_allowed, steepest};
+
+    #[test]
+    fn an_image_taken_late_may_show_the_speed_further_up_the_ramp() {
+        // On time: the limit itself.
+        assert_eq!(speed_allowed(54, 4, 0, 10_000), 54);
+        // 1 µs to a whole cycle late: one cycle's speed-up with its slack.
+        assert_eq!(speed_allowed(54, 4, 1, 10_000), 60);
+        assert_eq!(speed_allowed(54, 4, 10_000, 10_000), 60);
+        // Two cycles begun in the delay.
+        assert_eq!(speed_allowed(54, 4, 10_001, 10_000), 66);
+        // A cruising reference (no ramp in force) allows nothing more, however late.
+        assert_eq!(speed_allowed(54, 0, 1_000_000, 10_000), 54);
+    }
 
     #[test]
     fn steepest_counts_a_change_per_the_requests_interval_when_the_images_lie_further_apart() {
