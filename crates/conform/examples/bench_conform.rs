@@ -14,7 +14,7 @@
 //!    port: the pty and the served model);
 //! 5. the same exchanges over TCP on loopback.
 //!
-//! Run: `cargo run --release -p drivespec-conform --example bench_sim [-- REPEATS]`.
+//! Run: `cargo run --release -p drivespec-conform --example bench_conform [-- REPEATS]`.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
 use drivespec_conform::dut::Dut;
@@ -116,7 +116,7 @@ fn main() {
     let cases = s.report.summary.total as f64;
     let simulated: u64 = s.report.cases.iter().map(|c| c.elapsed_us).sum();
     println!(
-        "| `drivespec conform hpd` against `--dut sim` (virtual time), {} cases, reports written | {:.0} ms, {:.0} cases/s, {:.0} s simulated per wall second ({:.1} s simulated) | `cargo run --release -p drivespec-conform --example bench_sim` |",
+        "| `drivespec conform hpd` against `--dut sim` (virtual time), {} cases, reports written | {:.0} ms, {:.0} cases/s, {:.0} s simulated per wall second ({:.1} s simulated) | `cargo run --release -p drivespec-conform --example bench_conform` |",
         s.report.summary.total,
         wall * 1e3,
         cases / wall,
@@ -145,7 +145,7 @@ fn main() {
     let wall = median(&mut walls);
     let simulated: u64 = s.report.cases.iter().map(|c| c.elapsed_us).sum();
     println!(
-        "| `drivespec conform psx3xx` against `--dut sim` (virtual time, {}), {} cases, reports written | {:.0} ms, {:.0} cases/s, {:.0} s simulated per wall second ({:.1} s simulated) | `cargo run --release -p drivespec-conform --example bench_sim` |",
+        "| `drivespec conform psx3xx` against `--dut sim` (virtual time, {}), {} cases, reports written | {:.0} ms, {:.0} cases/s, {:.0} s simulated per wall second ({:.1} s simulated) | `cargo run --release -p drivespec-conform --example bench_conform` |",
         s.report
             .run
             .model

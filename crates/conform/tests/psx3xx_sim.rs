@@ -5,7 +5,7 @@
 //! spec's table; every other of the 59 models runs the `isdu`, `guard`, `command`, `format`
 //! and `status` groups plus the first case of every other group. The whole suite on all 59
 //! models takes several minutes in a debug build on the shared machine; the release benchmark
-//! (`examples/bench_sim.rs`) runs it on every model and reports the failures.
+//! (`examples/bench_conform.rs`) runs it on every model and reports the failures.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,

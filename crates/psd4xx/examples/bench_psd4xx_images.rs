@@ -1,7 +1,7 @@
 //! Benchmark of PSD4xx process-image decoding (bus description 3.5, 3.8): typed parse of
 //! output and input images, and the full field-by-field explanation.
 //!
-//! `cargo run --release -p drivespec-psd4xx --example bench_images [MILLIONS]` (default 4).
+//! `cargo run --release -p drivespec-psd4xx --example bench_psd4xx_images [MILLIONS]` (default 4).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,

@@ -4,7 +4,7 @@
 //! conformance runner do, and (b) with the drive left to itself between commands
 //! (`advance` straight to the end of the run).
 //!
-//! `cargo run --release -p drivespec-psd4xx --example bench_sim [RUNS]` (default 200).
+//! `cargo run --release -p drivespec-psd4xx --example bench_psd4xx_sim [RUNS]` (default 200).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,

@@ -1,7 +1,7 @@
 //! Benchmark of PSx3xx process-image decoding (instruction manual 3.3): typed parse of the
 //! three output formats and the input image, and the full field-by-field explanation.
 //!
-//! `cargo run --release -p drivespec-psx3xx --example bench_images [MILLIONS]` (default 4).
+//! `cargo run --release -p drivespec-psx3xx --example bench_psx3xx_images [MILLIONS]` (default 4).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,

@@ -4,7 +4,7 @@
 //! and an IO-Link master at the device's MinCycleTime (8 ms, ISDU 0 sub 3) do, and (b) with
 //! the drive left to itself between commands (`advance` straight to the end of the run).
 //!
-//! `cargo run --release -p drivespec-psx3xx --example bench_sim [RUNS]` (default 200).
+//! `cargo run --release -p drivespec-psx3xx --example bench_psx3xx_sim [RUNS]` (default 200).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
