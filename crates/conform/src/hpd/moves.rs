@@ -747,6 +747,19 @@ fn positioning(g: &mut Gen, m: &Motion, reverse: bool) {
                     slack_steps: m.travel_slack(top + SPEED_SLACK_RPM),
                 },
             ),
+            // The unit table of section 3: Pr0 in rpm and Pr62:63 in 4096 steps a
+            // revolution, judged together by how far the position moves at the speed read.
+            check(
+                "HPD-PAR-002",
+                Envelope::Travel {
+                    position: 0,
+                    speed: 2,
+                    steps_per_rev: STEPS_PER_REV,
+                    top_rpm: top + SPEED_SLACK_RPM,
+                    slack: TRAVEL_SLACK_PERCENT,
+                    slack_steps: m.travel_slack(top + SPEED_SLACK_RPM),
+                },
+            ),
             check(
                 "HPD-MODE-9-001",
                 Envelope::Ends {
