@@ -104,6 +104,35 @@ pub struct OpenPoint {
     pub movement: bool,
 }
 
+/// One cycle of a case run as a check of the device's own images sees it
+/// ([`CyclicFamily::own_checks`]).
+pub struct Seen<'c, I, O> {
+    /// The step the cycle belongs to.
+    pub step: usize,
+    /// The output sent in the cycle.
+    pub out: &'c O,
+    /// The device's input image, when it answered.
+    pub device: Option<&'c I>,
+}
+
+/// What a check judged from the device's own images found ([`CyclicFamily::own_checks`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum OwnVerdict {
+    /// The device broke `requirement` in cycle `cycle`: what was allowed there.
+    Broken {
+        /// The cycle (index into the run's cycles) that shows it.
+        cycle: usize,
+        /// The requirement broken.
+        requirement: String,
+        /// What the device showed, one line.
+        what: String,
+        /// What the requirement allowed there, one line.
+        allowed: String,
+    },
+    /// The device took an outcome the manual allows where the check does not apply.
+    Allowed(CaseFinding),
+}
+
 /// One step: who it is for, one line, what it does.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepDef<A> {
@@ -364,6 +393,16 @@ pub trait CyclicFamily<'s> {
     fn open(_case: &Self::Case) -> Option<OpenPoint> {
         None
     }
+    /// Checks of a motion case judged from the device's own images alone, not against the
+    /// reference's: `reqs` are the case's requirements, `cycles` the run. By default none.
+    fn own_checks(
+        &self,
+        _case: &Self::Case,
+        _reqs: &[String],
+        _cycles: &[Seen<'_, Self::Input, Self::Output>],
+    ) -> Vec<OwnVerdict> {
+        Vec::new()
+    }
     /// The requirements bounding a run's speed change (acceleration, deceleration), which a
     /// motion case checks against the reference's steepest change per cycle
     /// ([`RAMP_SLACK_PERCENT`]). By default none: the ramps are not judged.
@@ -559,6 +598,9 @@ struct Finding {
     /// Whether `breaks` leads even in a case that checks one requirement: the check found a
     /// change the other side does not make at all, or a ramp or sign the images show alone.
     own: bool,
+    /// What was allowed, where a check of the device's own images says it (shown instead
+    /// of the reference's image).
+    allowed: Option<String>,
 }
 
 impl Finding {
@@ -570,6 +612,7 @@ impl Finding {
             what,
             breaks: Vec::new(),
             own: false,
+            allowed: None,
         }
     }
 
@@ -786,6 +829,8 @@ struct Run<'r, 's, I, O> {
     open: Option<OpenPoint>,
     /// Live values read in a motion case.
     live: Vec<LiveRead>,
+    /// What the family's checks of the device's own images found ([`CyclicFamily::own_checks`]).
+    own: Vec<OwnVerdict>,
     /// Why the case cannot be run on this device: an injection the reference takes and the
     /// device answers `UNSUPPORTED` (optional, crates/cyclic/README.md); the case is skipped.
     unsupported: Option<String>,
@@ -1266,6 +1311,28 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
         if let Some((i, c)) = run.cycles.iter().enumerate().find(|(_, c)| c.dut.is_err()) {
             bad.push(Finding::at(i, c.step, None, "no input image".to_owned()));
         }
+        // The checks of the device's own images lead where they find something: they judge
+        // the requirement itself, not a difference from the reference.
+        for v in &run.own {
+            if let OwnVerdict::Broken {
+                cycle,
+                requirement,
+                what,
+                allowed,
+            } = v
+            {
+                let mut f = Finding::at(
+                    *cycle,
+                    run.cycles.get(*cycle).map_or(0, |c| c.step),
+                    None,
+                    what.clone(),
+                )
+                .breaking(vec![requirement.clone()])
+                .leading(true);
+                f.allowed = Some(allowed.clone());
+                bad.push(f);
+            }
+        }
         let running = self.family.running_bit();
         let mut bounds = vec![0];
         bounds.extend(run.arrivals.iter().copied());
@@ -1637,8 +1704,12 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                     let reqs =
                         self.family
                             .judged_cited(&reqs, &c.out, c.dut.as_ref().ok(), reference);
-                    run.failure =
-                        Some(self.cycle_failure(&reqs, f.cycle, c, reference, f.what.clone()));
+                    let mut failure =
+                        self.cycle_failure(&reqs, f.cycle, c, reference, f.what.clone());
+                    if let Some(allowed) = &f.allowed {
+                        failure.expected.clone_from(allowed);
+                    }
+                    run.failure = Some(failure);
                 }
             }
         }
@@ -1755,6 +1826,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             arrivals: Vec::new(),
             open: F::open(case),
             live: Vec::new(),
+            own: Vec::new(),
             unsupported: None,
         };
         let reset_ok = match self.device.call(&Request::Reset) {
@@ -1792,6 +1864,18 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 });
             }
         }
+        if tol.motion {
+            let seen: Vec<Seen<'_, F::Input, F::Output>> = run
+                .cycles
+                .iter()
+                .map(|c| Seen {
+                    step: c.step,
+                    out: &c.out,
+                    device: c.dut.as_ref().ok(),
+                })
+                .collect();
+            run.own = self.family.own_checks(case, &info.requirements, &seen);
+        }
         self.judge(&mut run, tol);
         if F::plot(case) {
             let samples: Vec<Sample> = run
@@ -1817,7 +1901,16 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             });
         }
         // An open point is reported with the status bits the device ended with.
-        let findings = match (&run.open, &run.failure) {
+        // So is an outcome the manual allows that a check of the device's own images found.
+        let allowed: Vec<CaseFinding> = run
+            .own
+            .iter()
+            .filter_map(|v| match v {
+                OwnVerdict::Allowed(f) if run.failure.is_none() => Some(f.clone()),
+                _ => None,
+            })
+            .collect();
+        let mut findings = match (&run.open, &run.failure) {
             (Some(o), None) => {
                 let last = run.cycles.iter().rev().find_map(|c| c.dut.as_ref().ok());
                 let bits = last.map_or(0, |d| F::motion(d).2 & o.bits);
@@ -1831,6 +1924,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             }
             _ => Vec::new(),
         };
+        findings.extend(allowed);
         CaseRun {
             findings,
             checked: self.checked(&run),

@@ -67,6 +67,10 @@ pub enum Kind {
     /// The speed jumps to 50 rpm when a run starts and from there to 0 when it stops (no
     /// ramp below 50 rpm).
     SpeedJumps,
+    /// After a run aborted by clearing the release, a shaft turned at standstill (release set,
+    /// par 47 = 1) is run back to the last target although no run has completed since: the
+    /// release is withdrawn for one cycle and set again, which starts the run (4.1).
+    ReadjustAfterAbort,
 }
 
 /// The built-in spec with one positioning attempt instead of two (4.2.1), as a drive that
@@ -101,6 +105,10 @@ pub struct Mutant {
     error_cleared: bool,
     /// The control word last received.
     last_control: u16,
+    /// Whether a run was aborted by clearing the release and none has completed since.
+    aborted: bool,
+    /// Cycles left of the release withdrawn and set again that start the adjustment.
+    adjusting: u8,
 }
 
 impl Mutant {
@@ -124,6 +132,8 @@ impl Mutant {
             temperature: None,
             error_cleared: false,
             last_control: 0,
+            aborted: false,
+            adjusting: 0,
         }
     }
 }
@@ -144,6 +154,15 @@ impl CyclicDevice<'static> for Mutant {
                 self.drive.cycle(now, &b)?;
             }
             Kind::LoopInverted => out.control ^= bit("control", "Run without reference loop"),
+            Kind::ReadjustAfterAbort => {
+                if self.running && self.last_control & release != 0 && out.control & release == 0 {
+                    self.aborted = true;
+                }
+                if self.adjusting == 2 {
+                    out.control &= !release;
+                }
+                self.adjusting = self.adjusting.saturating_sub(1);
+            }
             Kind::ReleaseWithdrawalIgnored if self.running => out.control |= release,
             Kind::NewTargetIgnored => {
                 if self.running && out.control & transfer != 0 {
@@ -261,6 +280,11 @@ impl CyclicDevice<'static> for Mutant {
             {
                 input.speed = input.speed.signum() * input.speed.abs().max(50);
             }
+            Kind::ReadjustAfterAbort
+                if input.status & bit("status", "Target position reached") != 0 =>
+            {
+                self.aborted = false;
+            }
             Kind::LimitBitsSwapped => {
                 let (up, down) = (
                     bit("status", "Positive range limit"),
@@ -314,6 +338,15 @@ impl CyclicDevice<'static> for Mutant {
         match env {
             Env::Temperature(c) => self.temperature = Some(c),
             Env::PositionFault => self.error_cleared = false,
+            Env::Displace(_)
+                if self.kind == Kind::ReadjustAfterAbort
+                    && self.aborted
+                    && !self.running
+                    && self.last_control & bit("control", "Release") != 0
+                    && self.drive.parameter(47) == Ok(1) =>
+            {
+                self.adjusting = 2;
+            }
             _ => {}
         }
         let ok = self.drive.env(now, env);
@@ -545,6 +578,12 @@ pub fn mutants() -> Vec<Case> {
             name: "speed-jumps-without-ramp",
             must_fail: &["psd4xx/position/loop/up", "psd4xx/speed/changed-during-run"],
             breaks: &["PSD-VEL-003", "PSD-VEL-004", "PSD-PAR-2-001"],
+        },
+        Case {
+            kind: ReadjustAfterAbort,
+            name: "readjustment-after-an-aborted-run",
+            must_fail: &["psd4xx/position/readjust-after-abort"],
+            breaks: &["PSD-ADJ-009"],
         },
         Case {
             kind: ObstructionBitMissing,

@@ -32,6 +32,11 @@ pub enum Kind {
     /// acceleration and deceleration and a deceleration "successively reduced"): the run is
     /// reported ended, and live values are read, from the filtered motion.
     Shaft(Filter),
+    /// A run command refused for want of motor voltage (status bit 13) starts once the
+    /// voltage is back while the release stays set (3.3 par 90 and 3.6 bit 13 do not say
+    /// whether the command is dropped): the release is withdrawn for one cycle and set again,
+    /// which starts the run to the last target (4.1).
+    DeferredRun,
 }
 
 /// How the shaft follows the drive's trapezoid.
@@ -109,10 +114,12 @@ impl Shaft {
         }
     }
 
-    /// The shaft where the trapezoid is (power-up, a displacement by hand).
+    /// The shaft where the trapezoid is (power-up, a displacement by hand): the trapezoid's
+    /// sample too, so the next one is no new frame.
     fn snap(&mut self, pos: f64, speed: f64) {
         self.pos = pos;
         self.speed = speed;
+        self.before = Some((pos, speed));
         self.samples.clear();
         self.samples.push_back((pos, speed));
     }
@@ -137,6 +144,12 @@ pub struct Variant {
     /// Since when the save command in force came.
     saving_since: Option<Micros>,
     shaft: Shaft,
+    /// The control word and status word of the cycle before.
+    last: (u16, u16),
+    /// Whether a run command was refused for want of motor voltage, the release still set.
+    refused: bool,
+    /// Cycles left of the release withdrawn and set again that start a refused run.
+    restart: u8,
 }
 
 impl Variant {
@@ -159,6 +172,9 @@ impl Variant {
             reached_since: None,
             saving_since: None,
             shaft: Shaft::default(),
+            last: (0, 0),
+            refused: false,
+            restart: 0,
         }
     }
 }
@@ -173,13 +189,7 @@ fn per_device(number: u16) -> bool {
 }
 
 fn reached_bit() -> u16 {
-    let b = spec().family(FamilyId::Psd4xx).bitfield("status").unwrap();
-    1 << b
-        .bits
-        .iter()
-        .find(|x| x.name == "Target position reached")
-        .unwrap()
-        .bit
+    bit("status", "Target position reached")
 }
 
 impl Variant {
@@ -242,13 +252,12 @@ impl Variant {
 }
 
 fn running_bit() -> u16 {
-    let b = spec().family(FamilyId::Psd4xx).bitfield("status").unwrap();
-    1 << b
-        .bits
-        .iter()
-        .find(|x| x.name == "Drive is running")
-        .unwrap()
-        .bit
+    bit("status", "Drive is running")
+}
+
+fn bit(field: &str, name: &str) -> u16 {
+    let b = spec().family(FamilyId::Psd4xx).bitfield(field).unwrap();
+    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
 }
 
 impl CyclicDevice<'static> for Variant {
@@ -269,8 +278,29 @@ impl CyclicDevice<'static> for Variant {
             }
             (out.control, out.target) = self.applied;
         }
+        let release = bit("control", "Release");
+        let sent = out.control;
+        if self.restart == 2 {
+            out.control &= !release;
+        }
+        self.restart = self.restart.saturating_sub(1);
         let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
         let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
+        if self.kind == Kind::DeferredRun {
+            let missing = bit("status", "Motor voltage was missing");
+            let command = sent != self.last.0 && sent & release != 0;
+            if sent & release == 0 || input.status & running_bit() != 0 {
+                self.refused = false;
+            } else if command && input.status & missing != 0 && self.last.1 & missing == 0 {
+                self.refused = true;
+            } else if self.refused
+                && input.status & bit("status", "Power supply to motor available") != 0
+            {
+                self.refused = false;
+                self.restart = 2;
+            }
+            self.last = (sent, input.status);
+        }
         if let Kind::SlowSave(us) = self.kind {
             let save = rules
                 .pkw()
@@ -382,5 +412,6 @@ pub fn variants() -> Vec<(&'static str, Kind)> {
             Kind::Reading("par38-standstill", "par-39-only"),
         ),
         ("identity and measurements of its own", Kind::OwnValues),
+        ("run refused without U_mot deferred", Kind::DeferredRun),
     ]
 }

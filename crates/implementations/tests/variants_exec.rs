@@ -144,7 +144,7 @@ fn every_hpd_variant_over_exec_passes_the_line_cases() {
 }
 
 #[test]
-#[ignore = "14 variants × 5 runs take about 5 minutes of real time on 2 cores (327 s measured), too long for every CI run; run with --run-ignored"]
+#[ignore = "15 variants × 5 runs take about 5 minutes of real time on 2 cores (327 s measured), too long for every CI run; run with --run-ignored"]
 fn every_psd4xx_variant_over_exec_passes_five_runs_in_a_row() {
     every_variant_five_runs(FamilyId::Psd4xx, workers());
 }

@@ -1207,6 +1207,24 @@ impl Gen<'_> {
                 Judge::Exact => EXCHANGE,
                 Judge::Motion => MOTION,
             };
+            let open = typed.setup.open.as_ref().map(|o| OpenPoint {
+                requirement: o.requirement.clone(),
+                text: o.text.clone(),
+                bits: o
+                    .bits
+                    .iter()
+                    .filter_map(|b| 1u16.checked_shl(u32::from(*b)))
+                    .fold(0, |w, b| w | b),
+                movement: o.movement,
+            });
+            if let Some(o) = &open {
+                if f.requirement(&o.requirement).is_none() {
+                    self.errors.push(format!(
+                        "{}: scenario {:?}: unknown requirement {} of the open point",
+                        sc.file, sc.id, o.requirement
+                    ));
+                }
+            }
             self.push(
                 format!("psd4xx/{}", sc.id),
                 &reqs,
@@ -1215,7 +1233,7 @@ impl Gen<'_> {
                     steps,
                     tol,
                     plot: typed.setup.plot,
-                    open: None,
+                    open,
                 },
             );
         }

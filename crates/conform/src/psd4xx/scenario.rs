@@ -8,7 +8,7 @@ use drivespec_psd4xx::step::Step;
 use serde::{Deserialize, Deserializer};
 
 /// How a scenario is judged and shown (`setup` table).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct Setup {
     /// `exact`: the exchange tolerance; `motion`: the motion tolerance.
@@ -16,6 +16,25 @@ pub(crate) struct Setup {
     /// Whether the report gets a position/speed/status plot.
     #[serde(default)]
     pub plot: bool,
+    /// The point of a motion case the manual leaves open, if any.
+    #[serde(default)]
+    pub open: Option<Open>,
+}
+
+/// What a motion scenario does not judge because the manual leaves it open there; the case
+/// reports what the device showed.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Open {
+    /// The requirement the point belongs to.
+    pub requirement: String,
+    /// What the manual leaves open, one line.
+    pub text: String,
+    /// The status bits not judged (0..15).
+    pub bits: Vec<u16>,
+    /// Whether the direction of travel is not judged either.
+    #[serde(default)]
+    pub movement: bool,
 }
 
 /// The tolerance a scenario is judged with.

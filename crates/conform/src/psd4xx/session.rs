@@ -1,18 +1,23 @@
 //! Running PSD4xx cases ([`crate::cyclic_session`]): every cycle's input image (PKW block and
 //! status word exact) and every record and injection reply is compared with the reference's.
 
-use super::cases::{status_bit, OpenPoint, PsdCase, StepDef, PKW_MAX_CYCLES};
+use super::cases::{control_bit, status_bit, OpenPoint, PsdCase, StepDef, PKW_MAX_CYCLES};
 use super::{Psd4xxSuite, CYCLE_US};
 use crate::case::{CaseInfo, Finding};
 use crate::cyclic::{Env, Reply, Request, Server};
 use crate::cyclic_session::{
-    env_op, merged, same_length, CyclicFamily, CyclicSession, Op, Tolerance,
+    env_op, env_request, merged, same_length, CyclicFamily, CyclicSession, Op, OwnVerdict, Seen,
+    Tolerance,
 };
 use drivespec_psd4xx::pkw::Reply as PkwReply;
 use drivespec_psd4xx::step::Step;
 use drivespec_psd4xx::{Input, Output, PkwRequest, PkwResponse};
 use drivespec_spec::psd4xx::{PkwOp, PkwValue};
 use drivespec_spec::{DataType, Family, FamilyId, Protocol};
+
+/// The requirement that a run aborted by a stop command leaves the drive without adjustment
+/// until a new run command has completed correctly (4.6 notice).
+const ADJUST_AFTER_ABORT: &str = "PSD-ADJ-009";
 
 /// The value of one process-data field of an input image.
 type ImageValue = fn(&Input) -> i64;
@@ -176,6 +181,19 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
 
     fn open(case: &PsdCase) -> Option<OpenPoint> {
         case.open.clone()
+    }
+
+    /// A case citing PSD-ADJ-009 is judged by [`Psd4xx::adjust_after_abort`].
+    fn own_checks(
+        &self,
+        case: &PsdCase,
+        reqs: &[String],
+        cycles: &[Seen<'_, Input, Output>],
+    ) -> Vec<OwnVerdict> {
+        if !reqs.iter().any(|r| r == ADJUST_AFTER_ABORT) {
+            return Vec::new();
+        }
+        self.adjust_after_abort(case, cycles).into_iter().collect()
     }
 
     /// Idle: no PKW command, control word and target 0.
@@ -485,6 +503,97 @@ impl CyclicFamily<'static> for Psd4xx<'_, '_> {
 }
 
 impl Psd4xx<'_, '_> {
+    /// PSD-ADJ-009 (4.6 notice) judged from the device's own images: after a run aborted by
+    /// a stop command (the output clears the release while the device reports "Drive is
+    /// running") and the shaft turned at standstill (the case's last `displace` after it),
+    /// the actual position stays within par 44 (its delivery value) of where the turn left
+    /// it. A device that reported "Target position reached" at a standstill since the abort
+    /// has completed a run, so the rule no longer holds it back: not applicable, a finding.
+    /// None where the case never reaches that state.
+    fn adjust_after_abort(
+        &self,
+        case: &PsdCase,
+        cycles: &[Seen<'_, Input, Output>],
+    ) -> Option<OwnVerdict> {
+        let family = self.suite.family();
+        let release = control_bit(family, "Release").ok()?;
+        let running = status_bit(family, "Drive is running").ok()?;
+        let reached = status_bit(family, "Target position reached").ok()?;
+        let window = family
+            .parameter("44")
+            .and_then(|p| family.resolve(p, family.model(self.suite.model())).default)?;
+        let abort = cycles
+            .windows(2)
+            .position(|w| match w {
+                [a, b] => {
+                    a.out.control & release != 0
+                        && b.out.control & release == 0
+                        && a.device.is_some_and(|d| d.status & running != 0)
+                }
+                _ => false,
+            })?
+            .saturating_add(1);
+        let abort_step = cycles.get(abort)?.step;
+        let (turn_step, by) =
+            case.steps
+                .iter()
+                .enumerate()
+                .rev()
+                .find_map(|(n, s)| match &s.action {
+                    Step::Env { env } if n > abort_step => match env_request(0, env) {
+                        Ok(Request::Env {
+                            env: Env::Displace(by),
+                            ..
+                        }) => Some((n, by)),
+                        _ => None,
+                    },
+                    _ => None,
+                })?;
+        let after = cycles.iter().position(|c| c.step > turn_step)?;
+        let before = cycles.get(..after)?.iter().rev().find_map(|c| c.device)?;
+        let left = i64::from(before.actual).saturating_add(by);
+        let (lo, hi) = (left.saturating_sub(window), left.saturating_add(window));
+        let moved = cycles.iter().enumerate().skip(after).find_map(|(i, c)| {
+            c.device
+                .filter(|d| !(lo..=hi).contains(&i64::from(d.actual)))
+                .map(|d| (i, d))
+        });
+        let completed = cycles
+            .get(abort..moved.map_or(cycles.len(), |(i, _)| i))?
+            .iter()
+            .position(|c| {
+                c.device
+                    .is_some_and(|d| d.status & reached != 0 && d.status & running == 0)
+            })
+            .map(|k| abort.saturating_add(k));
+        let cycle_no = |i: usize| i.saturating_add(1);
+        match (completed, moved) {
+            (Some(k), moved) => Some(OwnVerdict::Allowed(Finding::Open {
+                requirement: ADJUST_AFTER_ABORT.to_owned(),
+                text: format!(
+                    "not applicable: the device reported a completed run (\"Target position reached\") in cycle {} (step {}) after the run aborted by the stop command in cycle {}; after the turn it {}",
+                    cycle_no(k),
+                    cycles.get(k).map_or(0, |c| c.step),
+                    cycle_no(abort),
+                    if moved.is_some() { "adjusted" } else { "did not adjust" }
+                ),
+            })),
+            (None, Some((i, d))) => Some(OwnVerdict::Broken {
+                cycle: i,
+                requirement: ADJUST_AFTER_ABORT.to_owned(),
+                what: format!(
+                    "actual position {}: the drive adjusts after the turn, with no run completed since the run aborted by the stop command in cycle {}",
+                    d.actual,
+                    cycle_no(abort)
+                ),
+                allowed: format!(
+                    "actual position {lo}…{hi} (where the turn by {by} left it, {left}, ± par 44 = {window}): no adjustment until a new run command has completed"
+                ),
+            }),
+            (None, None) => None,
+        }
+    }
+
     /// A read of a live value with a process-data field answered at cycle `at` (3.6: the
     /// value of the moment; PSD-PKW-004: held while the command is repeated), judged by the
     /// device's own process data: the request begins where the reference's answer does (it
