@@ -417,7 +417,7 @@ mod tests {
             ..Options::default()
         };
         let mut out: Vec<u8> = Vec::new();
-        let stats = with_cyclic_server(&spec, FamilyId::Psd4xx, None, |server, _| {
+        let stats = with_cyclic_server(&spec, FamilyId::Psd4xx, None, None, |server, _| {
             serve_cyclic_stream(
                 std::io::Cursor::new(input.as_bytes().to_vec()),
                 &mut out,
