@@ -10,6 +10,7 @@ use drivespec_conform::select::LevelFilter;
 use drivespec_conform::select::{closest, did_you_mean};
 use drivespec_conform::suite::Settings;
 use drivespec_conform::{Options, Progress};
+use drivespec_sim::reference::BrakeKind;
 use drivespec_spec::FamilyId;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -31,6 +32,10 @@ pub struct ConformArgs {
     /// Device model.
     #[arg(long)]
     model: Option<String>,
+    /// psx3xx: the device's brake option, snap or holding (manual 5.11–5.13; an ordering
+    /// option no ISDU entry reports). The model must be one the spec offers it for.
+    #[arg(long, value_name = "KIND")]
+    brake: Option<String>,
     /// Run only cases matching this glob (repeatable; `*` also matches `/`).
     #[arg(long = "case", value_name = "GLOB")]
     case: Vec<String>,
@@ -113,6 +118,13 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
     let dut: Dut = args.dut.parse()?;
     let spec = ctx.spec()?;
     let readings = strict_readings(&spec, &families, &args.reading)?;
+    let brake = match &args.brake {
+        Some(text) if families != [FamilyId::Psx3xx] => {
+            bail!("--brake {text}: the brake is an option of the psx3xx drives; run `drivespec conform psx3xx --brake {text}`")
+        }
+        Some(text) => Some(brake_kind(&spec, text)?),
+        None => None,
+    };
     let interrupt = Interrupt::install(args.timeout)?;
     let opts = Options {
         families,
@@ -123,6 +135,7 @@ pub fn run(args: ConformArgs, ctx: &Context) -> Result<Outcome> {
             model: args.model,
             slack_us: args.slack_ms.map(|ms| ms.saturating_mul(1000)),
             bit_rate: None,
+            brake,
             readings,
         },
         case: args.case,
@@ -321,4 +334,20 @@ fn strict_readings(
         out.push((option.to_owned(), reading.to_owned()));
     }
     Ok(out)
+}
+
+/// The brake option `text` names (spec `[[protocol.brake]] kind`, PSx3xx manual 5.11–5.13).
+pub(crate) fn brake_kind(spec: &drivespec_spec::Spec, text: &str) -> Result<BrakeKind> {
+    let kinds: Vec<&str> = spec
+        .family(FamilyId::Psx3xx)
+        .psx3xx()
+        .map(|p| p.brakes.iter().map(|b| b.kind.as_str()).collect())
+        .unwrap_or_default();
+    match BrakeKind::from_spec_name(text) {
+        Some(k) if kinds.contains(&k.spec_name()) => Ok(k),
+        _ => bail!(
+            "--brake {text:?}: no such brake option; the PSx3xx brakes are {} (manual 5.11-5.13)",
+            kinds.join(", ")
+        ),
+    }
 }

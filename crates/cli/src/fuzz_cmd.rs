@@ -101,6 +101,7 @@ pub fn run(args: FuzzArgs, ctx: &Context) -> Result<Outcome> {
             model: args.model,
             slack_us: args.slack_ms.map(|ms| ms.saturating_mul(1000)),
             bit_rate: None,
+            brake: None,
             readings: Vec::new(),
         },
         iterations: args.iterations,

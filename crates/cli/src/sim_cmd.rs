@@ -20,6 +20,10 @@ pub struct SimArgs {
     /// Device model, matched forgivingly.
     #[arg(long)]
     model: Option<String>,
+    /// psx3xx: the drive's brake option, snap or holding (manual 5.11–5.13); the model must be
+    /// one the spec offers it for.
+    #[arg(long, value_name = "KIND")]
+    brake: Option<String>,
     /// Serial address of the drive (HPD Pr27).
     #[arg(long, default_value_t = 0, visible_alias = "address")]
     addr: u8,
@@ -96,6 +100,9 @@ pub fn run(args: SimArgs, ctx: &Context) -> Result<Outcome> {
         seed: args.seed,
     };
     faults.check()?;
+    if let (Some(text), false) = (&args.brake, family == FamilyId::Psx3xx) {
+        bail!("--brake {text}: the brake is an option of the psx3xx drives, not of {family}");
+    }
     if let Some(iface) = &args.profinet {
         return run_profinet(&args, ctx, family, iface, faults, time_limit);
     }
@@ -215,6 +222,10 @@ fn run_cyclic(
         bail!("--baud-code, --addr and --any-bit-rate are for hpd (serial line)");
     }
     let spec = ctx.spec()?;
+    let brake = match &args.brake {
+        Some(text) => Some(crate::conform_cmd::brake_kind(&spec, text)?),
+        None => None,
+    };
     let opts = Options {
         faults,
         log: args.log,
@@ -222,9 +233,13 @@ fn run_cyclic(
         max_clients: None,
         check_bit_rate: false,
     };
-    drivespec_sim::with_cyclic_server(&spec, family, args.model.as_deref(), |server, name| {
-        serve_cyclic(args, family, server, name, &opts)
-    })?
+    drivespec_sim::with_cyclic_server(
+        &spec,
+        family,
+        args.model.as_deref(),
+        brake,
+        |server, name| serve_cyclic(args, family, server, name, &opts),
+    )?
 }
 
 /// Serves `server` on the transport `args` names until stopped.
@@ -259,11 +274,20 @@ fn serve_cyclic(
         banner(&mut log, &format!("tcp:{local}"));
         let _ = writeln!(
             log,
-            "drivespec sim: test it with: drivespec conform {family} --dut tcp:{local}"
+            "drivespec sim: test it with: drivespec conform {family} --dut tcp:{local}{}",
+            options_of(args)
         );
         drivespec_sim::serve_cyclic_tcp(listener, server, opts, &stop, &mut log)?
     } else if args.pty {
-        serve_cyclic_pty(server, opts, &stop, &mut log, family, banner)?
+        serve_cyclic_pty(
+            server,
+            opts,
+            &stop,
+            &mut log,
+            family,
+            &options_of(args),
+            banner,
+        )?
     } else {
         banner(&mut log, "stdin/stdout");
         drivespec_sim::serve_cyclic_stdio(server, opts, &stop, &mut log)?
@@ -286,6 +310,16 @@ fn serve_cyclic(
     Ok(Outcome::Pass)
 }
 
+/// The `--model` and `--brake` a conformance run against the served drive needs (a brake
+/// is declared, not read from the device: PSx3xx manual 5.11–5.13).
+fn options_of(args: &SimArgs) -> String {
+    match (&args.brake, &args.model) {
+        (Some(b), Some(m)) => format!(" --model {m} --brake {b}"),
+        (Some(b), None) => format!(" --brake {b}"),
+        _ => String::new(),
+    }
+}
+
 #[cfg(unix)]
 fn serve_cyclic_pty(
     server: &mut Server<'_>,
@@ -293,6 +327,7 @@ fn serve_cyclic_pty(
     stop: &Stop,
     log: &mut dyn Write,
     family: FamilyId,
+    options: &str,
     banner: impl Fn(&mut dyn Write, &str),
 ) -> Result<Stats> {
     let pty = drivespec_sim::Pty::open(None)?;
@@ -300,7 +335,7 @@ fn serve_cyclic_pty(
     banner(log, pty.path());
     let _ = writeln!(
         log,
-        "drivespec sim: test it with: drivespec conform {family} --dut serial:{}",
+        "drivespec sim: test it with: drivespec conform {family} --dut serial:{}{options}",
         pty.path()
     );
     Ok(drivespec_sim::serve_cyclic_pty(
@@ -315,6 +350,7 @@ fn serve_cyclic_pty(
     _stop: &Stop,
     _log: &mut dyn Write,
     _family: FamilyId,
+    _options: &str,
     _banner: impl Fn(&mut dyn Write, &str),
 ) -> Result<Stats> {
     bail!("--pty needs a Unix system (pseudo-terminals); use --listen or --stdio")

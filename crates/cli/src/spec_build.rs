@@ -91,7 +91,7 @@ pub fn problems(spec: &Arc<Spec>) -> Vec<BuildProblem> {
                     device(Arc::clone(spec), id, &opts).map(drop)
                 }
                 FamilyId::Psd4xx | FamilyId::Psx3xx => {
-                    with_cyclic_server(spec, id, Some(&model.id), |_, _| ())
+                    with_cyclic_server(spec, id, Some(&model.id), None, |_, _| ())
                 }
             };
             if let Err(e) = served {

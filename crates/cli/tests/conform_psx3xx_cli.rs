@@ -89,3 +89,69 @@ fn all_lists_psx3xx_cases() {
     assert_eq!(out.status.code(), Some(0), "{text}");
     assert!(text.contains("psx3xx/guard/66/suppress"), "{text}");
 }
+
+#[test]
+fn a_declared_snap_brake_runs_the_brake_cases_against_a_served_drive_with_one() {
+    let dut = format!(
+        "exec:{} sim psx3xx --stdio --model PSE312-14 --brake snap",
+        BIN
+    );
+    let (code, out, json) = conform(
+        "brake",
+        &[
+            "psx3xx",
+            "--dut",
+            &dut,
+            "--model",
+            "PSE312-14",
+            "--brake",
+            "snap",
+            "--case",
+            "psx3xx/brake",
+            "--case",
+            "psx3xx/position/readjust-disabled",
+        ],
+    );
+    assert_eq!(code, 0, "{out}");
+    assert_eq!(json["run"]["brake"], "snap", "{json}");
+    assert_eq!(json["summary"]["passed"], 2, "{json}");
+    assert_eq!(json["summary"]["skipped"], 1, "{json}");
+    let skipped = json["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["status"] == "skipped")
+        .unwrap();
+    let reason = skipped["skip_reason"].as_str().unwrap();
+    assert!(
+        reason.starts_with("not applicable: the drive has a snap brake"),
+        "{reason}"
+    );
+}
+
+#[test]
+fn a_brake_the_model_cannot_have_is_a_usage_error() {
+    for (args, says) in [
+        (
+            &["psx3xx", "--brake", "snap"][..],
+            "PSE312-8 cannot have a snap brake; the snap brake is for PSx30x-14",
+        ),
+        (
+            &["psx3xx", "--model", "PSE312-14", "--brake", "holding"][..],
+            "PSE312-14 cannot have a holding brake; the holding brake is for PSE34xx",
+        ),
+        (
+            &["psx3xx", "--model", "PSE312-14", "--brake", "disc"][..],
+            "no such brake option; the PSx3xx brakes are snap, holding",
+        ),
+        (
+            &["psd4xx", "--brake", "snap"][..],
+            "the brake is an option of the psx3xx drives",
+        ),
+    ] {
+        let (code, out, _) = conform("brake-usage", args);
+        assert_eq!(code, 2, "{args:?}: {out}");
+        assert!(out.contains(says), "{args:?}: {out}");
+        assert_eq!(out.trim().lines().count(), 1, "{args:?}: {out}");
+    }
+}

@@ -148,6 +148,17 @@ fn bad_usage_exits_2() {
         &["sim", "psd4xx", "--stdio", "--baud-code", "3"],
         &["sim", "hpd", "--stdio", "--corrupt-images", "0.5"],
         &["sim", "psd4xx", "--listen", "udp:127.0.0.1:0"],
+        &["sim", "psx3xx", "--stdio", "--brake", "snap"],
+        &[
+            "sim",
+            "psx3xx",
+            "--stdio",
+            "--model",
+            "PSE312-14",
+            "--brake",
+            "disc",
+        ],
+        &["sim", "psd4xx", "--stdio", "--brake", "snap"],
     ] {
         let (code, _, err) = run_with(BIN, args, Some(""), &[]);
         assert_eq!(code, 2, "{args:?}: {err}");
@@ -170,4 +181,28 @@ fn psx3xx_is_served_on_stdio() {
     assert_eq!(lines[1], "OK");
     assert!(lines[2].starts_with("ERR "), "{out}");
     assert!(err.contains("psx3xx reference "), "{err}");
+}
+
+#[test]
+fn psx3xx_with_a_snap_brake_is_served_on_stdio() {
+    let (code, out, err) = run_with(
+        BIN,
+        &[
+            "sim",
+            "psx3xx",
+            "--stdio",
+            "--model",
+            "PSE312-14",
+            "--brake",
+            "snap",
+        ],
+        Some("HELLO drivespec-cyclic 1 psx3xx x\nRESET\n"),
+        &[],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().nth(1), Some("OK"), "{out}");
+    assert!(
+        err.contains("psx3xx reference PSE312-14 with a snap brake"),
+        "{err}"
+    );
 }

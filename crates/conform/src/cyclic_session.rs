@@ -133,6 +133,19 @@ pub enum OwnVerdict {
     Allowed(CaseFinding),
 }
 
+/// A step of a motion case through which the device must stand where it is, judged on its
+/// own input images alone: every image of the step shows the running bit clear, speed 0 and
+/// the position within the case's position tolerance of the step's first image.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Still {
+    /// The step.
+    pub step: usize,
+    /// The requirement a movement in the step breaks.
+    pub requirement: String,
+    /// What standing still means there, in words (`no adjustment run`).
+    pub what: String,
+}
+
 /// One step: who it is for, one line, what it does.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepDef<A> {
@@ -403,6 +416,16 @@ pub trait CyclicFamily<'s> {
     ) -> Vec<OwnVerdict> {
         Vec::new()
     }
+    /// The step of a motion case through which the device must stand still, if any. By
+    /// default none.
+    fn still(_case: &Self::Case) -> Option<Still> {
+        None
+    }
+    /// Why a case does not apply to the device under test (an option it has or lacks), if
+    /// it does not: the case is skipped with that reason. By default every case applies.
+    fn not_applicable(_case: &Self::Case) -> Option<String> {
+        None
+    }
     /// The requirements bounding a run's speed change (acceleration, deceleration), which a
     /// motion case checks against the reference's steepest change per cycle
     /// ([`RAMP_SLACK_PERCENT`]). By default none: the ramps are not judged.
@@ -526,13 +549,17 @@ pub struct CyclicSession<'a, F> {
 }
 
 /// Whether one side has arrived where an [`Op::Until`] waits: it has shown "Drive is running"
-/// since the step began, or it has stood still (running bit clear, speed 0) with an
-/// unchanged status word for [`Arrival::SETTLE_US`] and at least [`Arrival::MIN_CYCLES`]
-/// cycles. Each side is waited for on its own, so a device that starts later, brakes longer
-/// or confirms the position later than the reference is judged at its own arrival.
+/// since the step began and moved since, or shown it for [`Arrival::MIN_CYCLES`] cycles (a
+/// run that first waits, PSx3xx 5.12: for its brake to open); or it has stood still (running
+/// bit clear, speed 0) with an unchanged status word for [`Arrival::SETTLE_US`] and at least
+/// [`Arrival::MIN_CYCLES`] cycles. Each side is waited for on its own, so a device that starts
+/// later, brakes longer or confirms the position later than the reference is judged at its
+/// own arrival, its first movement on the same side of the wait's end as the reference's.
 struct Arrival {
     running: bool,
     seen: bool,
+    /// Cycles since the running bit was first seen, and whether the side has moved since.
+    under_way: (u32, bool),
     /// The status word the side stands still with, and for how many cycles.
     still: Option<(u16, u32)>,
     cycle_us: u64,
@@ -550,6 +577,7 @@ impl Arrival {
         Arrival {
             running,
             seen: false,
+            under_way: (0, false),
             still: None,
             cycle_us,
         }
@@ -558,6 +586,10 @@ impl Arrival {
     fn see(&mut self, (_, speed, status): (i64, i64, u16), running_bit: u16) {
         let on = status & running_bit != 0;
         self.seen |= on;
+        if self.seen {
+            let (n, moved) = self.under_way;
+            self.under_way = (n.saturating_add(1), moved || speed != 0);
+        }
         self.still = match self.still {
             _ if on || speed != 0 => None,
             Some((word, n)) if word == status => Some((word, n.saturating_add(1))),
@@ -567,7 +599,8 @@ impl Arrival {
 
     fn done(&self) -> bool {
         if self.running {
-            return self.seen;
+            let (n, moved) = self.under_way;
+            return self.seen && (moved || n >= Arrival::MIN_CYCLES);
         }
         self.still.is_some_and(|(_, n)| {
             n >= Arrival::MIN_CYCLES
@@ -790,6 +823,42 @@ fn first_difference<I, O, T: PartialEq + Clone>(
     })
 }
 
+/// The first image of the device in the step of `still` that shows a run (the `running`
+/// bit, a speed) or a position more than `slack` from the step's first image; `motion` gives
+/// an image's position, speed and status word.
+fn still_violation<I, O>(
+    cycles: &[Cycle<I, O>],
+    still: &Still,
+    slack: i64,
+    running: u16,
+    motion: impl Fn(&I) -> (i64, i64, u16),
+) -> Option<Finding> {
+    let mut images = cycles
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.step == still.step)
+        .filter_map(|(i, c)| c.dut.as_ref().ok().map(|d| (i, motion(d))));
+    let (_, (start, _, _)) = images.clone().next()?;
+    let (i, (position, speed, status)) = images.find(|(_, (p, v, st))| {
+        st & running != 0 || *v != 0 || p.saturating_sub(start).abs() > slack
+    })?;
+    Some(
+        Finding::at(
+            i,
+            still.step,
+            Some(i),
+            format!(
+                "{}: in step {} the device shows position {position} (the step began at {start}, at most {slack} from it), speed {speed}, the running bit {}",
+                still.what,
+                still.step,
+                if status & running != 0 { "set" } else { "clear" }
+            ),
+        )
+        .breaking(vec![still.requirement.clone()])
+        .leading(true),
+    )
+}
+
 /// " in step N" for a cycle, empty for none.
 fn step_of<I, O>(cycles: &[Cycle<I, O>], at: Option<usize>) -> String {
     at.and_then(|i| cycles.get(i))
@@ -831,6 +900,8 @@ struct Run<'r, 's, I, O> {
     live: Vec<LiveRead>,
     /// What the family's checks of the device's own images found ([`CyclicFamily::own_checks`]).
     own: Vec<OwnVerdict>,
+    /// The step the device must stand still through ([`CyclicFamily::still`]).
+    still: Option<Still>,
     /// Why the case cannot be run on this device: an injection the reference takes and the
     /// device answers `UNSUPPORTED` (optional, crates/cyclic/README.md); the case is skipped.
     unsupported: Option<String>,
@@ -1237,10 +1308,22 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 tol.position
             )
         };
+        let still = run.still.as_ref().filter(|_| tol.motion).map(|s| {
+            (
+                s.step,
+                format!(
+                    "{note}; {}: on the device's own images, no run, speed 0 and the position within ±{} of the step's first",
+                    s.requirement, tol.position
+                ),
+            )
+        });
         for r in &mut run.evidence {
             if r.ok.is_none() && r.role != Role::Cleanup {
                 r.ok = Some(!bad_steps.contains(&r.step));
-                r.note = Some(note.clone());
+                r.note = Some(match &still {
+                    Some((step, text)) if *step == r.step => text.clone(),
+                    _ => note.clone(),
+                });
             }
         }
     }
@@ -1334,20 +1417,33 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             }
         }
         let running = self.family.running_bit();
+        // Ahead of the comparisons with the reference: a movement in the still step shows
+        // there no later than in any of them, and its own requirement leads.
+        if let Some(s) = &run.still {
+            bad.extend(still_violation(
+                &run.cycles,
+                s,
+                tol.position,
+                running,
+                F::motion,
+            ));
+        }
         let mut bounds = vec![0];
         bounds.extend(run.arrivals.iter().copied());
         bounds.push(run.cycles.len());
-        // A case that ends while the device still moves is judged up to where the device has
-        // got: in its last segment the device's changes must begin the reference's, the rest
-        // may come after the end (a drive may react later than the reference).
+        // A case that ends while the device still moves, or while the reference does (a run
+        // it began shortly before the end, which the device may begin later), is judged up to
+        // where the device has got: in its last segment the device's changes must begin the
+        // reference's, the rest may come after the end (a drive may react later than the
+        // reference).
+        let moves = |i: &F::Input| {
+            let (_, speed, status) = F::motion(i);
+            speed != 0 || status & running != 0
+        };
         let moving_at_end = run
             .cycles
             .last()
-            .and_then(|c| c.dut.as_ref().ok())
-            .is_some_and(|d| {
-                let (_, speed, status) = F::motion(d);
-                speed != 0 || status & running != 0
-            });
+            .is_some_and(|c| moves(&c.reference) || c.dut.as_ref().is_ok_and(&moves));
         let end = run.cycles.len();
         let motion = |c: &Cycle<F::Input, F::Output>, dut: bool| {
             let i = if dut {
@@ -1827,6 +1923,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             open: F::open(case),
             live: Vec::new(),
             own: Vec::new(),
+            still: F::still(case),
             unsupported: None,
         };
         let reset_ok = match self.device.call(&Request::Reset) {
@@ -1956,6 +2053,15 @@ impl<'s, F: CyclicFamily<'s>> Session for CyclicSession<'_, F> {
                 elapsed_us: 0,
             };
         };
+        if let Some(reason) = F::not_applicable(case) {
+            return CaseRun {
+                findings: Vec::new(),
+                checked: Vec::new(),
+                outcome: Outcome::Skip { reason },
+                evidence: Vec::new(),
+                elapsed_us: 0,
+            };
+        }
         // The case borrows the family; run a copy of it.
         let (info, case) = (info.clone(), case.clone());
         self.run_suite_case(&info, &case)

@@ -71,7 +71,7 @@ pub struct Options {
     pub families: Vec<FamilyId>,
     /// The device under test.
     pub dut: Dut,
-    /// Address, seed, model, slack.
+    /// Address, seed, model, brake, slack.
     pub settings: Settings,
     /// `--case` patterns.
     pub case: Vec<String>,
@@ -539,6 +539,9 @@ fn replay_line(opts: &Options, settings: &Settings, id: &str) -> String {
     ) {
         words.push(format!("--model {}", shell_quote(m)));
     }
+    if let Some(b) = settings.brake {
+        words.push(format!("--brake {}", b.spec_name()));
+    }
     words.join(" ")
 }
 
@@ -626,6 +629,7 @@ fn build_report(
             seed: settings.seed,
             address: settings.address,
             model: settings.model.clone(),
+            brake: settings.brake.map(|b| b.spec_name().to_owned()),
             case: opts.case.clone(),
             skip: opts.skip.clone(),
             level: opts.level.as_str().to_owned(),

@@ -10,6 +10,7 @@
 use crate::case::{CaseInfo, CaseRun};
 use crate::dut::Dut;
 use crate::link::{LinkError, Micros};
+use drivespec_sim::reference::BrakeKind;
 use drivespec_spec::{FamilyId, Spec};
 
 /// How cases are generated and sessions opened.
@@ -25,6 +26,9 @@ pub struct Settings {
     pub slack_us: Option<Micros>,
     /// Bit rate of the line (serial `?baud=`); None: the delivery value.
     pub bit_rate: Option<u32>,
+    /// The PSx3xx brake option of the device (`--brake`; manual 5.11–5.13): an ordering
+    /// option no ISDU entry reports. None: no brake.
+    pub brake: Option<BrakeKind>,
     /// Erratum readings made strict (`--reading OPTION=READING`): the only admissible
     /// reading of that erratum; every reading of the others is accepted.
     pub readings: Vec<(String, String)>,
@@ -51,7 +55,8 @@ pub enum SetupError {
 impl From<drivespec_sim::reference::ReferenceError> for SetupError {
     fn from(e: drivespec_sim::reference::ReferenceError) -> SetupError {
         match e {
-            drivespec_sim::reference::ReferenceError::UnknownModel { .. } => {
+            drivespec_sim::reference::ReferenceError::UnknownModel { .. }
+            | drivespec_sim::reference::ReferenceError::NoSuchBrake { .. } => {
                 SetupError::Usage(e.to_string())
             }
             other => SetupError::Spec(other.to_string()),
@@ -92,6 +97,12 @@ pub fn suite<'s>(
     family: FamilyId,
     settings: &Settings,
 ) -> Result<Box<dyn Suite + 's>, SetupError> {
+    if let (Some(b), false) = (settings.brake, family == FamilyId::Psx3xx) {
+        return Err(SetupError::Usage(format!(
+            "--brake {}: the brake is an option of the psx3xx drives, not of {family}",
+            b.spec_name()
+        )));
+    }
     match family {
         FamilyId::Hpd => Ok(Box::new(crate::hpd::HpdSuite::new(spec, settings)?)),
         FamilyId::Psd4xx => Ok(Box::new(crate::psd4xx::Psd4xxSuite::new(spec, settings)?)),

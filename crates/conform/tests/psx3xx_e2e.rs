@@ -22,7 +22,7 @@ fn serve(model: &'static str) -> String {
     let addr = listener.local_addr().unwrap();
     std::thread::spawn(move || {
         let spec = Spec::builtin().unwrap();
-        let reference = drivespec_sim::reference::psx3xx(&spec, Some(model)).unwrap();
+        let reference = drivespec_sim::reference::psx3xx(&spec, Some(model), None).unwrap();
         let mut server = reference.server(FamilyId::Psx3xx);
         let (stream, _) = listener.accept().unwrap();
         stream.set_nodelay(true).unwrap();

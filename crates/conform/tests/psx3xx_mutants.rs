@@ -1,7 +1,9 @@
 //! PSx3xx mutation tests: the reference drive with one planted deviation
 //! (`drivespec_implementations::psx3xx_mutants`), served over the cyclic protocol in-process, as the device under
 //! test. Each mutant must fail the cases named for it, and every case it fails must cite a
-//! requirement the deviation breaks; the mutation score is printed.
+//! requirement the deviation breaks; the mutation score is printed. A mutant built on a model
+//! with a brake option (`Kind::brake`) is run by a suite that declares them (`--model`,
+//! `--brake`).
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -19,15 +21,35 @@ use drivespec_conform::suite::{Session, Settings, Suite};
 use drivespec_implementations::psx3xx_mutants::{mutants, suite_mutants, Kind, Mutant};
 use drivespec_implementations::spec;
 
+/// The suite settings that declare the model and brake option of a mutant of `kind`.
+fn settings(kind: Kind) -> Settings {
+    let (model, brake) = kind.brake().unzip();
+    Settings {
+        model: model.map(str::to_owned),
+        brake,
+        ..Settings::default()
+    }
+}
+
 #[test]
 fn every_psx3xx_mutant_fails_the_cases_covering_its_deviation() {
-    let suite = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+    let plain = Psx3xxSuite::new(spec(), &Settings::default()).unwrap();
+    let braked: Vec<(Kind, Psx3xxSuite<'_>)> = mutants()
+        .into_iter()
+        .chain(suite_mutants())
+        .filter(|m| m.kind.brake().is_some())
+        .map(|m| (m.kind, Psx3xxSuite::new(spec(), &settings(m.kind)).unwrap()))
+        .collect();
     let all: Vec<_> = mutants().into_iter().chain(suite_mutants()).collect();
     let mut caught = 0;
     let mut problems = Vec::new();
     let mut report = Vec::new();
     let mut led_by_effect = Vec::new();
     for m in &all {
+        let suite = braked
+            .iter()
+            .find(|(k, _)| *k == m.kind)
+            .map_or(&plain, |(_, s)| s);
         let server = Server::new(m.name, "psx3xx", Box::new(Mutant::new(m.kind)));
         let mut session = suite.session(Box::new(LocalPeer::new(m.name, server)));
         let breaks: Vec<Pattern> = m.breaks.iter().map(|b| Pattern::new(b).unwrap()).collect();

@@ -5,7 +5,9 @@
 //! spec's table; every other of the 59 models runs the `isdu`, `guard`, `command`, `format`
 //! and `status` groups plus the first case of every other group. The whole suite on all 59
 //! models takes several minutes in a debug build on the shared machine; the release benchmark
-//! (`examples/bench_conform.rs`) runs it on every model and reports the failures.
+//! (`examples/bench_conform.rs`) runs it on every model and reports the failures. A case for the
+//! other brake option (manual 5.4) is skipped as not applicable; the whole suite also runs
+//! with a snap brake on a model that may have one.
 #![allow(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -16,8 +18,12 @@
 use drivespec_conform::case::Outcome;
 use drivespec_conform::dut::Dut;
 use drivespec_conform::suite::{suite, Settings};
+use drivespec_sim::reference::BrakeKind;
 use drivespec_spec::{FamilyId, Spec};
 use std::collections::BTreeMap;
+
+/// How the reason of a case for the other brake option begins.
+const NOT_APPLICABLE: &str = "not applicable: ";
 
 /// Runs the cases `pick` selects on `model`; the number run and the failures.
 fn run_model(
@@ -29,7 +35,18 @@ fn run_model(
         model: model.map(str::to_owned),
         ..Settings::default()
     };
-    let s = suite(spec, FamilyId::Psx3xx, &settings).unwrap();
+    run_settings(spec, &settings, pick, &mut |_, _| {})
+}
+
+/// Runs the cases `pick` selects with `settings`, showing each case's ID and outcome to
+/// `seen`; the number run and the failures (a case skipped as not applicable is none).
+fn run_settings(
+    spec: &Spec,
+    settings: &Settings,
+    pick: &dyn Fn(&str, usize) -> bool,
+    seen: &mut dyn FnMut(&str, &Outcome),
+) -> (usize, Vec<String>) {
+    let s = suite(spec, FamilyId::Psx3xx, settings).unwrap();
     let mut session = s.open(&Dut::default()).unwrap();
     let mut failed = Vec::new();
     let mut run = 0;
@@ -42,8 +59,11 @@ fn run_model(
             continue;
         }
         run += 1;
-        match session.run(i).outcome {
+        let outcome = session.run(i).outcome;
+        seen(&c.id, &outcome);
+        match outcome {
             Outcome::Pass => {}
+            Outcome::Skip { reason } if reason.starts_with(NOT_APPLICABLE) => {}
             Outcome::Skip { reason } => failed.push(format!("{}: skipped: {reason}", c.id)),
             Outcome::Fail(f) => failed.push(format!(
                 "{}: {} expected {} got {}",
@@ -117,4 +137,70 @@ fn psx3xx_case_counts_by_group() {
     }
     let ids: std::collections::BTreeSet<&str> = s.cases().iter().map(|c| c.id.as_str()).collect();
     assert_eq!(ids.len(), s.cases().len(), "duplicate case IDs");
+}
+
+#[test]
+fn with_a_snap_brake_every_case_passes_or_is_not_applicable_and_the_brake_cases_run() {
+    let spec = Spec::builtin().unwrap();
+    let family = spec.family(FamilyId::Psx3xx);
+    let model = family
+        .models
+        .iter()
+        .find(|m| {
+            drivespec_sim::reference::psx3xx(&spec, Some(&m.id), Some(BrakeKind::Snap)).is_ok()
+        })
+        .unwrap();
+    let settings = Settings {
+        model: Some(model.id.clone()),
+        brake: Some(BrakeKind::Snap),
+        ..Settings::default()
+    };
+    let (mut skipped, mut braked) = (Vec::new(), Vec::new());
+    let (n, failed) = run_settings(&spec, &settings, &|_, _| true, &mut |id, o| {
+        if let Outcome::Skip { reason } = o {
+            skipped.push((id.to_owned(), reason.clone()));
+        }
+        if id.starts_with("psx3xx/brake/") {
+            braked.push((id.to_owned(), o.clone()));
+        }
+    });
+    println!(
+        "{} with a snap brake: {n} cases, {} failed, {} not applicable",
+        model.id,
+        failed.len(),
+        skipped.len()
+    );
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    assert!(braked.len() >= 2, "{braked:?}");
+    assert!(
+        braked.iter().all(|(_, o)| *o == Outcome::Pass),
+        "{braked:?}"
+    );
+    for id in [
+        "readjust-against-loop",
+        "readjust-no-loop-both",
+        "readjust-with-loop",
+    ] {
+        let (_, reason) = skipped
+            .iter()
+            .find(|(c, _)| c.ends_with(id))
+            .unwrap_or_else(|| panic!("{id} ran with a snap brake"));
+        assert!(reason.contains("no adjustment function"), "{reason}");
+    }
+    // Without a brake the brake cases are the ones not applicable.
+    let (_, failed) = run_settings(
+        &spec,
+        &Settings {
+            model: Some(model.id.clone()),
+            ..Settings::default()
+        },
+        &|id, _| id.starts_with("psx3xx/brake/"),
+        &mut |id, o| {
+            assert!(
+                matches!(o, Outcome::Skip { reason } if reason.starts_with(NOT_APPLICABLE)),
+                "{id}: {o:?}"
+            );
+        },
+    );
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
 }

@@ -1,5 +1,6 @@
 //! PSx3xx legal variants (`drivespec_implementations::psx3xx_variants`): drives that differ from the reference
-//! only where the manual allows. Each must pass every case; the cases a variant fails are
+//! only where the manual allows. Each must pass every case, also built with a snap brake and
+//! run by a suite that declares it (`--brake snap`); the cases a variant fails are
 //! printed with what the suite expected and what came.
 #![allow(
     clippy::unwrap_used,
@@ -27,6 +28,32 @@ fn every_psx3xx_legal_variant_passes() {
         let failed = failures(suite.cases(), &mut session);
         let ids: Vec<&str> = failed.iter().map(|(id, _)| id.as_str()).collect();
         println!("{name:<36} fails {:>3} case(s): {ids:?}", failed.len());
+        problems.extend(describe(name, &failed));
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn every_psx3xx_legal_variant_with_a_snap_brake_passes() {
+    use drivespec_implementations::psx3xx_mutants::SNAP_BRAKE_MODEL;
+    use drivespec_sim::reference::BrakeKind;
+    let brake = Some((SNAP_BRAKE_MODEL, BrakeKind::Snap));
+    let settings = Settings {
+        model: Some(SNAP_BRAKE_MODEL.to_owned()),
+        brake: Some(BrakeKind::Snap),
+        ..Settings::default()
+    };
+    let suite = Psx3xxSuite::new(spec(), &settings).unwrap();
+    let mut problems = Vec::new();
+    for (name, kind) in variants() {
+        let server = Server::new(name, "psx3xx", Box::new(Variant::with_brake(kind, brake)));
+        let mut session = suite.session(Box::new(LocalPeer::new(name, server)));
+        let failed = failures(suite.cases(), &mut session);
+        let ids: Vec<&str> = failed.iter().map(|(id, _)| id.as_str()).collect();
+        println!(
+            "{name:<36} with a snap brake fails {:>3} case(s): {ids:?}",
+            failed.len()
+        );
         problems.extend(describe(name, &failed));
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));

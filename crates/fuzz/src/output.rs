@@ -211,6 +211,7 @@ pub(crate) fn build(
             seed: desc.seed,
             address: desc.address,
             model: desc.model.clone(),
+            brake: None,
             case: Vec::new(),
             skip: Vec::new(),
             level: "should".to_owned(),

@@ -126,6 +126,8 @@ impl<'a, 's> CyclicFuzz<'s> for PsxFuzz<'a, 's> {
             tol: if moves { MOTION } else { EXACT },
             plot: false,
             open: None,
+            still: None,
+            not_applicable: None,
         };
         (info, case)
     }

@@ -6,7 +6,7 @@ use crate::spec;
 use drivespec_cyclic::{CyclicDevice, Env, Reply};
 use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::{Request, Target, Value};
-use drivespec_psx3xx::model::Drive;
+use drivespec_psx3xx::model::{BrakeKind, Drive};
 use drivespec_psx3xx::{Guards, Output, Stamp};
 use drivespec_spec::{Access, Readings};
 
@@ -78,6 +78,23 @@ pub enum Kind {
     /// The status word is sent least significant byte first, the other values most
     /// significant byte first.
     StatusBytesSwapped,
+    /// A drive with a snap brake readjusts: turned out of the positioning window at
+    /// standstill with control bits 4 and 10 set, it runs back to its target.
+    BrakeReadjusts,
+}
+
+/// A model the snap brake is offered for (manual 5.12: PSx31x-14), the default's sibling.
+pub const SNAP_BRAKE_MODEL: &str = "PSE312-14";
+
+impl Kind {
+    /// The model and brake option the mutant is built with, None for the default model
+    /// without brake: a run against it declares them (`--model`, `--brake`).
+    pub fn brake(self) -> Option<(&'static str, BrakeKind)> {
+        match self {
+            Kind::BrakeReadjusts => Some((SNAP_BRAKE_MODEL, BrakeKind::Snap)),
+            _ => None,
+        }
+    }
 }
 
 /// The reference drive with one planted deviation.
@@ -93,6 +110,9 @@ pub struct Mutant<'s> {
     last_control: u16,
     /// The jog control word kept while the jog runs (jog mutant).
     kept_jog: Option<u16>,
+    /// The target in force and the one a readjustment runs to instead while the master keeps
+    /// it (brake mutant: a target one step off is a new one, 4.5).
+    readjust_to: Option<(i32, i32)>,
 }
 
 fn control_bit(drive: &Drive<'_>, name: &str) -> u16 {
@@ -125,7 +145,8 @@ fn error_name(
 
 impl Mutant<'static> {
     pub fn new(kind: Kind) -> Mutant<'static> {
-        let reference = drivespec_sim::reference::psx3xx(spec(), None).unwrap();
+        let (model, brake) = kind.brake().unzip();
+        let reference = drivespec_sim::reference::psx3xx(spec(), model, brake).unwrap();
         Mutant {
             drive: reference.drive,
             kind,
@@ -133,6 +154,7 @@ impl Mutant<'static> {
             last_stamp: None,
             last_control: 0,
             kept_jog: None,
+            readjust_to: None,
         }
     }
 }
@@ -174,6 +196,13 @@ impl<'s> Mutant<'s> {
             } => (control_word, target),
             Output::TimeStamp { .. } => return,
         };
+        if let Some((kept, instead)) = self.readjust_to {
+            if *target == kept {
+                *target = instead;
+            } else {
+                self.readjust_to = None;
+            }
+        }
         match self.kind {
             Kind::ReadjustBitIgnored if *word & release != 0 => {
                 *word |= control_bit(&self.drive, "Readjustment");
@@ -463,6 +492,32 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                 }
                 ok
             }
+            (Kind::BrakeReadjusts, Env::Displace(_)) => {
+                let ok = CyclicDevice::env(&mut self.drive, now, env);
+                let enabled =
+                    control_bit(&self.drive, "Release") | control_bit(&self.drive, "Readjustment");
+                let still =
+                    self.drive.status_word() & status_bit(&self.drive, "Drive is running") == 0;
+                let target = self.drive.target();
+                let off =
+                    (i64::from(self.drive.input().actual) - target).abs() > int(&self.drive, "131");
+                let kept = i32::try_from(target).ok();
+                if let (true, Some(kept)) = (
+                    ok && still && off && self.last_control & enabled == enabled,
+                    kept,
+                ) {
+                    let instead = kept.saturating_add(1);
+                    self.readjust_to = Some((kept, instead));
+                    let out = Output::ControlTarget {
+                        control_word: self.last_control,
+                        target: instead,
+                    };
+                    if self.drive.handle_output(now, &out).is_ok() {
+                        while self.drive.poll_input().is_some() {}
+                    }
+                }
+                ok
+            }
             (Kind::JogKeysIgnored, Env::Keys { .. }) => true,
             (Kind::SavedLostOnPowerCycle, Env::PowerCycle) => {
                 let ok = CyclicDevice::env(&mut self.drive, now, env);
@@ -666,6 +721,12 @@ pub fn suite_mutants() -> Vec<Case> {
             name: "limits into the safety margins acknowledged",
             must_fail: &["psx3xx/position/measuring-range"],
             breaks: &["PSX-POS-001", "PSX-MAP-005", "PSX-DP-ERR-004"],
+        },
+        Case {
+            kind: Kind::BrakeReadjusts,
+            name: "drive with a snap brake readjusting",
+            must_fail: &["psx3xx/brake/no-readjustment-*"],
+            breaks: &["PSX-ADJ-010"],
         },
         Case {
             kind: Kind::StatusBytesSwapped,

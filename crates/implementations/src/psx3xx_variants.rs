@@ -7,7 +7,7 @@ use crate::spec;
 use drivespec_cyclic::{CyclicDevice, Env, Reply};
 use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::Request;
-use drivespec_psx3xx::model::Drive;
+use drivespec_psx3xx::model::{BrakeKind, Drive};
 use drivespec_psx3xx::Output;
 use drivespec_spec::FamilyId;
 use std::collections::VecDeque;
@@ -45,7 +45,14 @@ pub struct Variant<'s> {
 impl Variant<'static> {
     /// The variant `kind`.
     pub fn new(kind: Kind) -> Variant<'static> {
-        let reference = drivespec_sim::reference::psx3xx(spec(), None).unwrap();
+        Variant::with_brake(kind, None)
+    }
+
+    /// The variant `kind` built on `model` with its brake option (manual 5.11–5.13), or on
+    /// the default model without brake.
+    pub fn with_brake(kind: Kind, brake: Option<(&str, BrakeKind)>) -> Variant<'static> {
+        let (model, brake) = brake.unzip();
+        let reference = drivespec_sim::reference::psx3xx(spec(), model, brake).unwrap();
         Variant {
             drive: reference.drive,
             kind,

@@ -36,14 +36,22 @@ const MAX_LINE: usize = 65_536;
 /// How long the accept loop sleeps when no client is waiting.
 const ACCEPT_POLL: Duration = Duration::from_millis(5);
 
-/// Builds the cyclic server on the reference model of `family` (`model`: matched forgivingly)
-/// and hands it to `f` with one line naming it (family and model) for banners.
+/// Builds the cyclic server on the reference model of `family` (`model`: matched forgivingly;
+/// `brake`: the PSx3xx brake option, PSx3xx manual 5.11–5.13) and hands it to `f` with one
+/// line naming it (family, model and brake) for banners.
 pub fn with_cyclic_server<R>(
     spec: &Spec,
     family: FamilyId,
     model: Option<&str>,
+    brake: Option<reference::BrakeKind>,
     f: impl FnOnce(&mut Server<'_>, &str) -> R,
 ) -> Result<R, ServeError> {
+    if let (Some(b), false) = (brake, family == FamilyId::Psx3xx) {
+        return Err(ServeError::Usage(format!(
+            "a {} brake is an option of the psx3xx drives, not of {family}",
+            b.spec_name()
+        )));
+    }
     match family {
         FamilyId::Psd4xx => {
             let r = reference::psd4xx(spec, model)?;
@@ -51,8 +59,15 @@ pub fn with_cyclic_server<R>(
             Ok(f(&mut r.server(family), &name))
         }
         FamilyId::Psx3xx => {
-            let r = reference::psx3xx(spec, model)?;
-            let name = format!("psx3xx reference {}", r.model.id);
+            let r = reference::psx3xx(spec, model, brake)?;
+            let name = match brake {
+                Some(b) => format!(
+                    "psx3xx reference {} with a {} brake",
+                    r.model.id,
+                    b.spec_name()
+                ),
+                None => format!("psx3xx reference {}", r.model.id),
+            };
             Ok(f(&mut r.server(family), &name))
         }
         other => Err(ServeError::NotAvailable { family: other }),
@@ -402,7 +417,7 @@ mod tests {
             ..Options::default()
         };
         let mut out: Vec<u8> = Vec::new();
-        let stats = with_cyclic_server(&spec, FamilyId::Psd4xx, None, |server, _| {
+        let stats = with_cyclic_server(&spec, FamilyId::Psd4xx, None, None, |server, _| {
             serve_cyclic_stream(
                 std::io::Cursor::new(input.as_bytes().to_vec()),
                 &mut out,
@@ -478,7 +493,7 @@ mod tests {
     #[test]
     fn psx3xx_is_served_and_others_and_unknown_models_are_refused() {
         let spec = Spec::builtin().unwrap();
-        let hello = with_cyclic_server(&spec, FamilyId::Psx3xx, None, |server, name| {
+        let hello = with_cyclic_server(&spec, FamilyId::Psx3xx, None, None, |server, name| {
             (
                 server.handle_line("HELLO drivespec-cyclic 1 psx3xx x"),
                 name.to_owned(),
@@ -491,11 +506,42 @@ mod tests {
         );
         assert!(hello.1.starts_with("psx3xx reference "), "{hello:?}");
         assert!(matches!(
-            with_cyclic_server(&spec, FamilyId::Hpd, None, |_, _| ()),
+            with_cyclic_server(&spec, FamilyId::Hpd, None, None, |_, _| ()),
             Err(ServeError::NotAvailable { .. })
         ));
         assert!(matches!(
-            with_cyclic_server(&spec, FamilyId::Psd4xx, Some("no such model"), |_, _| ()),
+            with_cyclic_server(
+                &spec,
+                FamilyId::Psd4xx,
+                Some("no such model"),
+                None,
+                |_, _| ()
+            ),
+            Err(ServeError::Usage(_))
+        ));
+    }
+
+    #[test]
+    fn a_psx3xx_brake_is_served_on_the_models_that_may_have_it_and_refused_elsewhere() {
+        use crate::reference::BrakeKind;
+        let spec = Spec::builtin().unwrap();
+        let snap = Some(BrakeKind::Snap);
+        let name = with_cyclic_server(&spec, FamilyId::Psx3xx, Some("PSE312-14"), snap, |_, n| {
+            n.to_owned()
+        })
+        .unwrap();
+        assert_eq!(name, "psx3xx reference PSE312-14 with a snap brake");
+        let refused =
+            with_cyclic_server(&spec, FamilyId::Psx3xx, Some("PSE312-8"), snap, |_, _| ());
+        match refused {
+            Err(ServeError::Usage(text)) => {
+                assert!(text.contains("PSE312-8 cannot have a snap brake"), "{text}");
+                assert!(text.contains("PSx31x-14"), "{text}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            with_cyclic_server(&spec, FamilyId::Psd4xx, None, snap, |_, _| ()),
             Err(ServeError::Usage(_))
         ));
     }

@@ -91,7 +91,8 @@ pub enum ServeError {
 impl From<reference::ReferenceError> for ServeError {
     fn from(e: reference::ReferenceError) -> ServeError {
         match e {
-            reference::ReferenceError::UnknownModel { .. } => ServeError::Usage(e.to_string()),
+            reference::ReferenceError::UnknownModel { .. }
+            | reference::ReferenceError::NoSuchBrake { .. } => ServeError::Usage(e.to_string()),
             other => ServeError::Model(other.to_string()),
         }
     }

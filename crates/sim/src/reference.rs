@@ -3,6 +3,7 @@
 //! serves and what a conformance suite's cases expect at their start.
 
 use drivespec_cyclic::{CyclicDevice, Server};
+pub use drivespec_psx3xx::model::BrakeKind;
 use drivespec_spec::{DeviceModel, Family, FamilyId, Spec};
 
 /// The PSD4xx model taken when none is named: an ungeared PSD 401 (the model the spec's
@@ -35,6 +36,19 @@ pub enum ReferenceError {
         query: String,
         /// The family's model IDs.
         known: Vec<String>,
+    },
+    /// The PSx3xx model cannot have the brake option asked for (PSx3xx manual 5.11–5.13,
+    /// spec `[[protocol.brake]] models`).
+    #[error("PSx3xx model {model} cannot have a {brake} brake; the {brake} brake is for {} (manual {section})", models.join(", "))]
+    NoSuchBrake {
+        /// The model.
+        model: String,
+        /// The brake kind asked for.
+        brake: &'static str,
+        /// The model patterns that may have it.
+        models: Vec<String>,
+        /// The manual sections of the option.
+        section: String,
     },
     /// The PSD4xx drive model cannot be built from the spec.
     #[error(transparent)]
@@ -94,13 +108,16 @@ pub fn psd4xx<'s>(
     Ok(Reference { model, drive })
 }
 
-/// The PSx3xx reference drive of `model` (default [`PSX3XX_DEFAULT_MODEL`]); a gearbox type
-/// without a documented ISDU 79 code reports [`UNDOCUMENTED_CODE`].
+/// The PSx3xx reference drive of `model` (default [`PSX3XX_DEFAULT_MODEL`]) with the brake
+/// option `brake` (manual 5.11–5.13; a model the spec's `[[protocol.brake]]` does not offer it
+/// for is an error); a gearbox type without a documented ISDU 79 code reports
+/// [`UNDOCUMENTED_CODE`].
 pub fn psx3xx<'s>(
     spec: &'s Spec,
     model: Option<&str>,
+    brake: Option<BrakeKind>,
 ) -> Result<Reference<'s, drivespec_psx3xx::model::Drive<'s>>, ReferenceError> {
-    use drivespec_psx3xx::model::{Drive, DriveConfig};
+    use drivespec_psx3xx::model::{Drive, DriveConfig, ModelError};
     let family = spec.family(FamilyId::Psx3xx);
     let model = self::model(family, "PSx3xx", model, PSX3XX_DEFAULT_MODEL)?;
     let mut config = DriveConfig::new(&model.id);
@@ -108,6 +125,20 @@ pub fn psx3xx<'s>(
         // PSX-ERRATUM-016: the ISDU 79 code of this gearbox type is undocumented.
         config.model_code = Some(UNDOCUMENTED_CODE);
     }
-    let drive = Drive::new(spec, config)?;
+    config.brake = brake;
+    let drive = Drive::new(spec, config).map_err(|e| match e {
+        ModelError::NoSuchBrake { model, brake } => {
+            let option = family
+                .psx3xx()
+                .and_then(|p| p.brakes.iter().find(|b| b.kind == brake));
+            ReferenceError::NoSuchBrake {
+                model,
+                brake,
+                models: option.map(|b| b.models.clone()).unwrap_or_default(),
+                section: option.map(|b| b.source.clone()).unwrap_or_default(),
+            }
+        }
+        other => other.into(),
+    })?;
     Ok(Reference { model, drive })
 }

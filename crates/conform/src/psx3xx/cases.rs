@@ -4,6 +4,7 @@
 //! time-out table, the spec's `sequence` vectors ([`sequence`]), plus hand-written status,
 //! time-out and positioning sequences (manual 3–5).
 
+mod brake;
 mod scenario;
 mod sequence;
 
@@ -15,6 +16,7 @@ use drivespec_psx3xx::isdu::{Target, Value};
 use drivespec_psx3xx::model::Drive;
 use drivespec_psx3xx::step::Step;
 use drivespec_psx3xx::{Output, Rules, Stamp, TsCode};
+use drivespec_spec::psx3xx::Brake;
 use drivespec_spec::{Access, DataType, DeviceModel, Family, FamilyId, Level, Parameter, Readings};
 
 /// ISDU entries the hand-written sequences use (manual 3.1 table); every value, range and
@@ -35,7 +37,7 @@ mod isdu {
 /// One step of a case.
 pub type StepDef = crate::cyclic_session::StepDef<Step>;
 
-pub use crate::cyclic_session::{OpenPoint, Tolerance, MOTION};
+pub use crate::cyclic_session::{OpenPoint, Still, Tolerance, MOTION};
 
 /// Tolerance of the ISDU cases: every cycle and every live value exact.
 pub const EXACT: Tolerance = Tolerance {
@@ -59,6 +61,10 @@ pub struct PsxCase {
     pub plot: bool,
     /// The point of a motion case the manual leaves open, if any.
     pub open: Option<OpenPoint>,
+    /// The step the device must stand still through, if any.
+    pub still: Option<Still>,
+    /// Why the case does not apply to the drive's brake option, if it does not (5.4).
+    pub not_applicable: Option<String>,
 }
 
 /// A process output in the format of `out`, then one cycle (manual 3.3.1).
@@ -122,6 +128,8 @@ const RUN_MAX: u32 = 10_000;
 
 struct Gen<'a, 's> {
     family: &'a Family,
+    /// The spec's record of the drive's brake option, None without brake (5.11–5.13).
+    brake: Option<&'a Brake>,
     model: &'a DeviceModel,
     rules: &'a Rules<'s>,
     base: &'a Drive<'s>,
@@ -186,6 +194,10 @@ impl<'a, 's> Gen<'a, 's> {
         }
         requirements.sort();
         requirements.dedup();
+        let mut case = case;
+        if case.tol.motion {
+            case.not_applicable = self.not_applicable(&requirements);
+        }
         let steps = case.steps.iter().map(|s| s.text.clone()).collect();
         self.out.push((
             CaseInfo {
@@ -212,6 +224,8 @@ impl<'a, 's> Gen<'a, 's> {
                 tol: EXACT,
                 plot: false,
                 open: None,
+                still: None,
+                not_applicable: None,
             },
         );
     }
@@ -228,6 +242,8 @@ impl<'a, 's> Gen<'a, 's> {
                 tol: MOTION,
                 plot: true,
                 open: None,
+                still: None,
+                not_applicable: None,
             },
         );
     }
@@ -435,6 +451,8 @@ impl<'a, 's> Gen<'a, 's> {
                     tol: EXACT,
                     plot: false,
                     open: None,
+                    still: None,
+                    not_applicable: None,
                 },
             );
             if p.access == Access::R {
@@ -466,6 +484,8 @@ impl<'a, 's> Gen<'a, 's> {
                         tol: EXACT,
                         plot: false,
                         open: None,
+                        still: None,
+                        not_applicable: None,
                     },
                 );
             }
@@ -569,6 +589,8 @@ impl<'a, 's> Gen<'a, 's> {
                     tol: EXACT,
                     plot: false,
                     open: None,
+                    still: None,
+                    not_applicable: None,
                 },
             );
         }
@@ -1545,8 +1567,14 @@ pub(crate) fn generate<'s>(
     base: &Drive<'s>,
     cycle_us: u64,
 ) -> Result<(Vec<CaseInfo>, Vec<PsxCase>), GenerateError> {
+    let brake = base.brake().and_then(|kind| {
+        family
+            .psx3xx()
+            .and_then(|p| p.brakes.iter().find(|b| b.kind == kind.spec_name()))
+    });
     let mut g = Gen {
         family,
+        brake,
         model,
         rules: base.rules(),
         base,
@@ -1561,6 +1589,7 @@ pub(crate) fn generate<'s>(
     g.timestamp_cases();
     g.scenario_cases();
     g.sequence_cases();
+    g.brake_cases();
     if let Some(e) = g.errors.first() {
         return Err(GenerateError::Spec {
             first: e.clone(),

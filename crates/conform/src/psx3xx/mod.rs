@@ -48,10 +48,11 @@ pub struct Psx3xxSuite<'s> {
 }
 
 impl<'s> Psx3xxSuite<'s> {
-    /// Generates the cases for `settings.model` (default [`DEFAULT_MODEL`]).
+    /// Generates the cases for `settings.model` (default [`DEFAULT_MODEL`]) with the brake
+    /// option `settings.brake` (manual 5.11–5.13).
     pub fn new(spec: &'s Spec, settings: &Settings) -> Result<Psx3xxSuite<'s>, SetupError> {
         let family = spec.family(FamilyId::Psx3xx);
-        let reference = reference::psx3xx(spec, settings.model.as_deref())?;
+        let reference = reference::psx3xx(spec, settings.model.as_deref(), settings.brake)?;
         let cycle_us = min_cycle_us(&reference.drive)?;
         let (infos, cases) = cases::generate(family, reference.model, &reference.drive, cycle_us)
             .map_err(|e| SetupError::Spec(e.to_string()))?;

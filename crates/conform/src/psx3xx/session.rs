@@ -7,7 +7,7 @@ use crate::case::CaseInfo;
 use crate::cyclic::{Env, Reply, Request, Server};
 use crate::cyclic_session::{
     env_op, merged, same_length, status_bit_rules, CyclicFamily, CyclicSession, Live, Op,
-    OpenPoint, Tolerance,
+    OpenPoint, Still, Tolerance,
 };
 use drivespec_psd4xx::model::LinkEvent as BusEvent;
 use drivespec_psx3xx::isdu::ErrorType;
@@ -230,6 +230,15 @@ impl<'s> CyclicFamily<'s> for Psx3xx<'_, 's> {
 
     fn open(case: &PsxCase) -> Option<OpenPoint> {
         case.open.clone()
+    }
+
+    fn still(case: &PsxCase) -> Option<Still> {
+        case.still.clone()
+    }
+
+    /// A case for the other brake option (5.4, `--brake`).
+    fn not_applicable(case: &PsxCase) -> Option<String> {
+        case.not_applicable.clone()
     }
 
     fn cycle_us(&self) -> u64 {

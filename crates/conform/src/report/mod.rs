@@ -145,6 +145,9 @@ pub struct RunInfo {
     pub address: u8,
     /// Device model, when given.
     pub model: Option<String>,
+    /// The PSx3xx brake option declared (`--brake`; manual 5.11–5.13), when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub brake: Option<String>,
     /// `--case` patterns.
     pub case: Vec<String>,
     /// `--skip` patterns.

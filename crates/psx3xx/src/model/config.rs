@@ -17,6 +17,16 @@ pub enum BrakeKind {
 }
 
 impl BrakeKind {
+    /// Every brake option (5.11–5.13).
+    pub const ALL: [BrakeKind; 2] = [BrakeKind::Snap, BrakeKind::Holding];
+
+    /// The brake whose spec `kind` is `name` (case-insensitive), None for another name.
+    pub fn from_spec_name(name: &str) -> Option<BrakeKind> {
+        BrakeKind::ALL
+            .into_iter()
+            .find(|k| k.spec_name().eq_ignore_ascii_case(name.trim()))
+    }
+
     /// The spec's `kind` of the brake (5.11–5.13).
     pub fn spec_name(self) -> &'static str {
         match self {

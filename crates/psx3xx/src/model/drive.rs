@@ -1,7 +1,7 @@
 //! The PSx3xx reference drive: process images, ISDU server, IO-Link communication, jog keys,
 //! environment and power on top of the positioning core (manual chapters 3–5).
 
-use super::config::DriveConfig;
+use super::config::{BrakeKind, DriveConfig};
 use super::error::ModelError;
 use super::family::PsxFamily;
 use super::io::{Event, IsduAnswer, JogKeys, LedLight, Leds, LinkEvent, RunState};
@@ -326,6 +326,11 @@ impl<'s> Drive<'s> {
     /// The target in force (ISDU 112, manual 3.3.1).
     pub fn target(&self) -> i64 {
         self.target
+    }
+
+    /// The brake option of the drive, None without brake (manual 5.11–5.13).
+    pub fn brake(&self) -> Option<BrakeKind> {
+        self.fam.brake.map(|b| b.kind)
     }
 
     /// Whether the brake is open (manual 5.12, 5.13); false for drives without brake.

@@ -83,6 +83,8 @@ impl Gen<'_, '_> {
                 tol,
                 plot,
                 open,
+                still: None,
+                not_applicable: None,
             };
             self.push(
                 format!("psx3xx/{}", record.id),

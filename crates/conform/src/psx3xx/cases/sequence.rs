@@ -74,6 +74,8 @@ impl Gen<'_, '_> {
                         tol: MOTION,
                         plot: true,
                         open: None,
+                        still: None,
+                        not_applicable: None,
                     },
                 );
             }
