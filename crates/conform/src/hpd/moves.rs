@@ -100,7 +100,7 @@ pub(crate) fn generate(g: &mut Gen) {
     reserved_while_busy(g, &m);
     clear_increment(g, &m);
     servo_error_latch(g, &m);
-    for start in 1..=3 {
+    for start in names::TEST_STARTS {
         test_profile(g, &m, start);
     }
     wiring_test(g, &m);
@@ -1086,9 +1086,9 @@ fn test_profile(g: &mut Gen, m: &Motion, start: i64) {
     let tenths = TEST_PAUSE_TENTHS
         .max(i64::try_from((4 * round).div_ceil(US_PER_TENTH)).unwrap_or(TEST_PAUSE_TENTHS));
     let pause_us = u64::try_from(tenths).unwrap_or(0) * US_PER_TENTH;
-    let (forward, revs_x2, words) = match start {
-        2 => (true, TEST_REVS, "Pr52 / 2 revolutions at positive speed"),
-        3 => (false, 2 * TEST_REVS, "Pr52 revolutions at negative speed"),
+    let (forward, revs_x2, words) = match names::TEST_STARTS.iter().position(|s| *s == start) {
+        Some(1) => (true, TEST_REVS, "Pr52 / 2 revolutions at positive speed"),
+        Some(2) => (false, 2 * TEST_REVS, "Pr52 revolutions at negative speed"),
         _ => (true, 2 * TEST_REVS, "Pr52 revolutions at positive speed"),
     };
     let stroke = revs_x2 * STEPS_PER_REV / 2;

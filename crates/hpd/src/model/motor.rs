@@ -610,7 +610,7 @@ impl Drive {
     /// stroke is a trapezoid at Pr51 rpm that ends on its distance ("no overrun").
     /// DECISION: the manual gives the profile no ramps; it accelerates on the speed loop's
     /// ramps Pr8 (positive speed) or Pr10 (negative) and decelerates on Pr9 or Pr11, as the
-    /// motion style uses them. A starting point other than 2 or 3 starts as 1; a distance
+    /// motion style uses them. Any other starting point starts as 1; a distance
     /// below 0 counts as 0.
     fn test_stroke(&mut self, t: Micros) {
         if !self.testing() || self.motor.profile.is_some() {
@@ -621,8 +621,8 @@ impl Drive {
         let (dir, revs, start_at) = match self.motor.test {
             None => {
                 let (dir, revs) = match self.mem_i(ml.p53) {
-                    2 => (1.0, revs / 2.0),
-                    3 => (-1.0, revs),
+                    names::START_HALF_FORWARD => (1.0, revs / 2.0),
+                    names::START_REVERSE => (-1.0, revs),
                     _ => (1.0, revs),
                 };
                 (dir, revs, t.saturating_add(ml.style.start_latency_us))
