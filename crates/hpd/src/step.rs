@@ -300,6 +300,52 @@ pub enum Envelope {
         /// Position error allowed at the end (steps).
         window: i64,
     },
+    /// The first stroke of a back-and-forth motion (manual 3.6.3 test profile): the first
+    /// speed read that is not 0 has the sign `forward` asks for, and the farthest the shaft
+    /// gets from where the first round saw it, up to its first read at 0 rpm or in the other
+    /// direction, lies within `min..=max` steps. A stroke still under way at the end of the
+    /// watch is judged only for its direction and for not having gone beyond `max`.
+    FirstStroke {
+        /// The reads that show the shaft.
+        shaft: Shaft,
+        /// The first stroke turns at positive speed.
+        forward: bool,
+        /// Shortest stroke (steps).
+        min: i64,
+        /// Longest stroke (steps).
+        max: i64,
+    },
+    /// After the first stroke (as [`Envelope::FirstStroke`] finds it) the shaft stands at 0
+    /// rpm for at least `min_us` before it turns again, judged on the longest standstill the
+    /// reads around it allow.
+    Pause {
+        /// The reads that show the shaft.
+        shaft: Shaft,
+        /// Shortest standstill (µs).
+        min_us: Micros,
+    },
+    /// After the first stroke and its standstill the shaft turns again, against the first
+    /// stroke's direction.
+    Reverses {
+        /// The reads that show the shaft.
+        shaft: Shaft,
+    },
+}
+
+/// A shaft seen through an absolute position within one revolution and a speed (manual 3.3
+/// Pr28 and Pr0): the revolutions are counted between two rounds, which takes the rounds
+/// close enough that at `top_rpm` the shaft turns less than half a revolution between them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shaft {
+    /// Index of the position's read (0..`steps_per_rev`).
+    pub position: usize,
+    /// Index of the speed's read (rpm).
+    pub speed: usize,
+    /// Position steps per revolution.
+    pub steps_per_rev: i64,
+    /// The highest speed of the motion (rpm).
+    pub top_rpm: i64,
 }
 
 /// Bytes as spaced hex text (`7E 80 01`); any form `drivespec_spec::hex::parse_hex` reads.

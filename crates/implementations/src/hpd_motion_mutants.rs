@@ -53,6 +53,12 @@ pub enum Kind {
     OrientationOvershoot,
     /// b70.5 reads 1 in mode 12 with b40.2 = 1, whatever the position error.
     ServoErrorStuck,
+    /// The mode-8 test profile takes Pr53 = 3 for 1: it starts at positive speed.
+    TestStartForward,
+    /// The mode-8 test profile does not pause between its strokes (Pr54 taken as 0).
+    TestNoPause,
+    /// The mode-8 test profile runs at the jog speed Pr50 instead of Pr51.
+    TestAtJogSpeed,
 }
 
 /// A drive with a deviation of its motion.
@@ -199,6 +205,18 @@ impl MotionMutant {
                 self.inner.handle_rx(now, bytes);
                 let _ = self.inner.set_value(now, &lock, kept);
             }
+            Kind::TestStartForward | Kind::TestNoPause | Kind::TestAtJogSpeed
+                if self.mode() == 8 && self.sets_b70(bytes, 0) =>
+            {
+                let (name, v) = match self.kind {
+                    Kind::TestStartForward if self.value("Pr53") == 3 => ("Pr53", 1),
+                    Kind::TestStartForward => ("Pr53", self.value("Pr53")),
+                    Kind::TestNoPause => ("Pr54", 0),
+                    _ => ("Pr51", self.value("Pr50")),
+                };
+                let _ = self.inner.set_value(now, &target(name), v);
+                self.inner.handle_rx(now, bytes);
+            }
             Kind::DefaultsKeepFlags
                 if [9, 10, 11].contains(&self.mode()) && self.sets_b99_11(bytes) =>
             {
@@ -326,6 +344,7 @@ pub struct Case {
 pub fn motion_mutants() -> Vec<Case> {
     const SPEED: &[&str] = &[
         "HPD-MODE-8-001",
+        "HPD-MODE-8-005",
         "HPD-MODE-002",
         "HPD-PAR-026",
         "HPD-PAR-027",
@@ -483,6 +502,30 @@ pub fn motion_mutants() -> Vec<Case> {
             first: "HPD-MODE-12-001",
             breaks: &["HPD-MODE-12-001"],
             must_fail: &["hpd/motion/mode-12/orientation"],
+        },
+        Case {
+            name: "mode-8 test profile starts forward with Pr53 = 3",
+            kind: Kind::TestStartForward,
+            first: "HPD-MODE-8-006",
+            breaks: &["HPD-MODE-8-006"],
+            must_fail: &["hpd/motion/mode-8/profile-start-3"],
+        },
+        Case {
+            name: "mode-8 test profile without its Pr54 pause",
+            kind: Kind::TestNoPause,
+            first: "HPD-MODE-8-005",
+            breaks: &["HPD-MODE-8-005"],
+            must_fail: &[
+                "hpd/motion/mode-8/profile-start-1",
+                "hpd/motion/mode-8/profile-start-3",
+            ],
+        },
+        Case {
+            name: "mode-8 test profile at the jog speed Pr50",
+            kind: Kind::TestAtJogSpeed,
+            first: "HPD-MODE-8-005",
+            breaks: &["HPD-MODE-8-005"],
+            must_fail: &["hpd/motion/mode-8/profile-start-2"],
         },
         Case {
             name: "b70.5 reads 1 in mode 12 with the loop closed",

@@ -7,7 +7,7 @@
 //! Pure functions over the samples; nothing here reads a clock.
 
 use crate::link::Micros;
-use drivespec_hpd::step::{Envelope, Within};
+use drivespec_hpd::step::{Envelope, Shaft, Within};
 
 /// One read of a round as the device answered it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -78,6 +78,23 @@ pub(crate) fn allowed(env: &Envelope) -> String {
         } => format!(
             "bit {bit} = 1 while the position moves from {from} to {to}; after it drops the position within {to} ± {window}"
         ),
+        Envelope::FirstStroke {
+            shaft,
+            forward,
+            min,
+            max,
+        } => format!(
+            "the first stroke turns at {} speed and ends {min}..={max} steps from the start ({} steps a revolution)",
+            if *forward { "positive" } else { "negative" },
+            shaft.steps_per_rev
+        ),
+        Envelope::Pause { min_us, .. } => format!(
+            "after the first stroke at least {:.1} ms at 0 rpm",
+            *min_us as f64 / 1000.0
+        ),
+        Envelope::Reverses { .. } => {
+            "after the first stroke and its pause the shaft turns the other way".to_owned()
+        }
     }
 }
 
@@ -242,6 +259,14 @@ pub(crate) fn judge(env: &Envelope, rounds: &[Round]) -> Result<String, String> 
             ranges,
             lag_us,
         } => bit_follows(rounds, *flags, *bit, *probe, ranges, *lag_us, start),
+        Envelope::FirstStroke {
+            shaft,
+            forward,
+            min,
+            max,
+        } => first_stroke(shaft, *forward, (*min, *max), rounds, start),
+        Envelope::Pause { shaft, min_us } => pause(shaft, *min_us, rounds, start),
+        Envelope::Reverses { shaft } => reverses(shaft, rounds, start),
         Envelope::BusyWhileMoving {
             flags,
             bit,
@@ -288,6 +313,207 @@ pub(crate) fn judge(env: &Envelope, rounds: &[Round]) -> Result<String, String> 
                 }
             ))
         }
+    }
+}
+
+/// The rounds that read both the position and the speed of `shaft`: the travel from the
+/// first of them (steps, the revolutions counted between rounds) and the speed's sample. Rounds
+/// so far apart that the shaft may have turned half a revolution at `top_rpm` cannot be counted.
+fn shaft_rounds(
+    shaft: &Shaft,
+    rounds: &[Round],
+    start: Micros,
+) -> Result<Vec<(i64, Sample)>, String> {
+    let rev = shaft.steps_per_rev.max(2);
+    let half = rev / 2;
+    let mut seen = Vec::new();
+    let mut last: Option<(Sample, i64)> = None;
+    for r in rounds {
+        let (Some(p), Some(v)) = (r.get(shaft.position), r.get(shaft.speed)) else {
+            continue;
+        };
+        let travel = match last {
+            None => 0,
+            Some((a, before)) => {
+                let dt = p.came.saturating_sub(a.sent);
+                let most = shaft.top_rpm.abs() as f64 * rev as f64 * dt as f64 / 60e6;
+                if most >= half as f64 {
+                    return Err(format!(
+                        "the position was read at {} and {}: at up to {} rpm the shaft may turn half a revolution in between, so its revolutions cannot be counted",
+                        ms(a.sent, start),
+                        ms(p.came, start),
+                        shaft.top_rpm
+                    ));
+                }
+                let step = (p.value - a.value).rem_euclid(rev);
+                before + if step >= half { step - rev } else { step }
+            }
+        };
+        last = Some((*p, travel));
+        seen.push((travel, *v));
+    }
+    Ok(seen)
+}
+
+/// Where the first stroke of a back-and-forth motion lies among the rounds of
+/// [`shaft_rounds`].
+struct Strokes {
+    /// Sign of the first speed read that is not 0.
+    dir: i64,
+    /// Index of that read.
+    from: usize,
+    /// Index of the first read after it at 0 rpm or in the other direction.
+    end: Option<usize>,
+    /// Index of the first read from `end` on that is not 0 rpm.
+    resume: Option<usize>,
+}
+
+fn strokes(seen: &[(i64, Sample)]) -> Option<Strokes> {
+    let from = seen.iter().position(|(_, v)| v.value != 0)?;
+    let dir = seen.get(from)?.1.value.signum();
+    let end =
+        (from + 1..seen.len()).find(|i| seen.get(*i).is_some_and(|(_, v)| v.value.signum() != dir));
+    let resume =
+        end.and_then(|e| (e..seen.len()).find(|i| seen.get(*i).is_some_and(|(_, v)| v.value != 0)));
+    Some(Strokes {
+        dir,
+        from,
+        end,
+        resume,
+    })
+}
+
+/// "positive" or "negative".
+fn sense(dir: i64) -> &'static str {
+    if dir > 0 {
+        "positive"
+    } else {
+        "negative"
+    }
+}
+
+/// The shaft's rounds and its first stroke, or why there is none.
+fn first_of(
+    shaft: &Shaft,
+    rounds: &[Round],
+    start: Micros,
+) -> Result<(Vec<(i64, Sample)>, Strokes), String> {
+    let seen = shaft_rounds(shaft, rounds, start)?;
+    match strokes(&seen) {
+        Some(s) => Ok((seen, s)),
+        None => Err(format!(
+            "the speed read 0 rpm in all {} round(s): the shaft never turned",
+            seen.len()
+        )),
+    }
+}
+
+/// [`Envelope::FirstStroke`].
+fn first_stroke(
+    shaft: &Shaft,
+    forward: bool,
+    (min, max): (i64, i64),
+    rounds: &[Round],
+    start: Micros,
+) -> Result<String, String> {
+    let (seen, s) = first_of(shaft, rounds, start)?;
+    let want = if forward { 1 } else { -1 };
+    let first = seen.get(s.from).map_or(0, |(_, v)| v.value);
+    let at = seen.get(s.from).map_or(start, |(_, v)| v.came);
+    if s.dir != want {
+        return Err(format!(
+            "the first speed read that is not 0 rpm, {first} rpm at {}, is {}; the first stroke turns at {} speed",
+            ms(at, start),
+            sense(s.dir),
+            sense(want)
+        ));
+    }
+    let upto = s.end.map_or(seen.len(), |e| e + 1);
+    let far = seen
+        .iter()
+        .take(upto)
+        .map(|(t, _)| t.abs())
+        .max()
+        .unwrap_or(0);
+    let revs = far as f64 / shaft.steps_per_rev.max(1) as f64;
+    match s.end.and_then(|e| seen.get(e)) {
+        Some((_, v)) if (min..=max).contains(&far) => Ok(format!(
+            "turned at {} speed from {}, {far} steps ({revs:.2} revolutions) up to {}",
+            sense(s.dir),
+            ms(at, start),
+            ms(v.came, start)
+        )),
+        Some((_, v)) => Err(format!(
+            "the first stroke turned {far} steps ({revs:.2} revolutions) up to {}, outside {min}..={max}",
+            ms(v.came, start)
+        )),
+        None if far <= max => Ok(format!(
+            "turned at {} speed from {}, {far} steps ({revs:.2} revolutions) by the end of the watch, still turning",
+            sense(s.dir),
+            ms(at, start)
+        )),
+        None => Err(format!(
+            "the first stroke turned {far} steps ({revs:.2} revolutions) and had not stopped, beyond {max}"
+        )),
+    }
+}
+
+/// [`Envelope::Pause`].
+fn pause(shaft: &Shaft, min_us: Micros, rounds: &[Round], start: Micros) -> Result<String, String> {
+    let (seen, s) = first_of(shaft, rounds, start)?;
+    let speed = |i: usize| seen.get(i).map(|(_, v)| *v);
+    let Some((end, last)) = s
+        .end
+        .and_then(|e| Some((speed(e)?, speed(e.checked_sub(1)?)?)))
+    else {
+        return Err("the first stroke never ended at 0 rpm".to_owned());
+    };
+    match s.resume.and_then(speed) {
+        None => Ok(format!(
+            "at 0 rpm from {} to the end of the watch",
+            ms(end.sent, start)
+        )),
+        Some(next) => {
+            let longest = next.came.saturating_sub(last.sent);
+            if longest >= min_us {
+                Ok(format!(
+                    "at 0 rpm from {} to {}",
+                    ms(end.sent, start),
+                    ms(next.came, start)
+                ))
+            } else {
+                Err(format!(
+                    "at 0 rpm for at most {:.1} ms (between the reads of {} rpm at {} and {} rpm at {}), at least {:.1} ms required",
+                    longest as f64 / 1000.0,
+                    last.value,
+                    ms(last.sent, start),
+                    next.value,
+                    ms(next.came, start),
+                    min_us as f64 / 1000.0
+                ))
+            }
+        }
+    }
+}
+
+/// [`Envelope::Reverses`].
+fn reverses(shaft: &Shaft, rounds: &[Round], start: Micros) -> Result<String, String> {
+    let (seen, s) = first_of(shaft, rounds, start)?;
+    if s.end.is_none() {
+        return Err("the first stroke never ended".to_owned());
+    }
+    match s.resume.and_then(|r| seen.get(r)) {
+        None => Err("the shaft did not turn again after its first stroke".to_owned()),
+        Some((_, v)) if v.value.signum() == -s.dir => Ok(format!(
+            "turned again at {} speed from {}",
+            sense(-s.dir),
+            ms(v.came, start)
+        )),
+        Some((_, v)) => Err(format!(
+            "turned again at {} rpm at {}, in the first stroke's direction",
+            v.value,
+            ms(v.came, start)
+        )),
     }
 }
 
@@ -424,6 +650,84 @@ mod tests {
         assert!(judge(&env, &bad).is_err());
         let early = rounds(&[(0, 0), (1_000, 128), (20_000, 0), (30_000, 0)]);
         assert!(judge(&env, &early).is_err());
+    }
+
+    /// Rounds of (Pr28, Pr0) 10 ms apart from `legs` of (steps a round, rpm, rounds).
+    fn shaft_legs(legs: &[(i64, i64, usize)]) -> Vec<Round> {
+        let mut at = 1_000;
+        let mut values = Vec::new();
+        for (step, rpm, n) in legs {
+            for _ in 0..*n {
+                at += step;
+                values.push((at.rem_euclid(4096), *rpm));
+            }
+        }
+        rounds(&values)
+    }
+
+    const SHAFT: Shaft = Shaft {
+        position: 0,
+        speed: 1,
+        steps_per_rev: 4096,
+        top_rpm: 200,
+    };
+
+    #[test]
+    fn a_test_profile_is_judged_by_its_strokes_counted_through_the_revolutions() {
+        // 82 rounds of 100 steps (8200 steps, two revolutions), 60 rounds (600 ms) at rest,
+        // then back.
+        let good = shaft_legs(&[(0, 0, 3), (100, 146, 82), (0, 0, 60), (-100, -146, 20)]);
+        let stroke = |forward| Envelope::FirstStroke {
+            shaft: SHAFT,
+            forward,
+            min: 8192 - 1024,
+            max: 8192 + 1024,
+        };
+        let pause = Envelope::Pause {
+            shaft: SHAFT,
+            min_us: 500_000,
+        };
+        let back = Envelope::Reverses { shaft: SHAFT };
+        assert!(judge(&stroke(true), &good).is_ok());
+        assert!(judge(&pause, &good).is_ok());
+        assert!(judge(&back, &good).is_ok());
+        // The wrong direction, one revolution only, or still turning beyond the stroke.
+        assert!(judge(&stroke(false), &good).is_err());
+        let short = shaft_legs(&[(100, 146, 41), (0, 0, 60), (-100, -146, 20)]);
+        assert!(judge(&stroke(true), &short).is_err());
+        let over = shaft_legs(&[(100, 146, 120)]);
+        assert!(judge(&stroke(true), &over).is_err());
+        let under_way = shaft_legs(&[(100, 146, 50)]);
+        assert!(judge(&stroke(true), &under_way).is_ok());
+        // Straight back without the pause, or on again in the first direction.
+        let no_pause = shaft_legs(&[(100, 146, 82), (0, 0, 2), (-100, -146, 20)]);
+        assert!(judge(&stroke(true), &no_pause).is_ok());
+        assert!(judge(&pause, &no_pause).is_err());
+        let again = shaft_legs(&[(100, 146, 82), (0, 0, 60), (100, 146, 20)]);
+        assert!(judge(&back, &again).is_err());
+        let never = shaft_legs(&[(100, 146, 82), (0, 0, 60)]);
+        assert!(judge(&pause, &never).is_ok());
+        assert!(judge(&back, &never).is_err());
+    }
+
+    #[test]
+    fn revolutions_between_reads_too_far_apart_are_not_counted() {
+        let fast = Shaft {
+            top_rpm: 3_000,
+            ..SHAFT
+        };
+        let r = shaft_legs(&[(100, 146, 82), (0, 0, 60), (-100, -146, 20)]);
+        let why = judge(
+            &Envelope::FirstStroke {
+                shaft: fast,
+                forward: true,
+                min: 0,
+                max: 10_000,
+            },
+            &r,
+        )
+        .unwrap_err();
+        assert!(why.contains("cannot be counted"), "{why}");
     }
 
     #[test]

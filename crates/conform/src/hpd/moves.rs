@@ -1,6 +1,6 @@
 //! `hpd/motion`: the motor turned through the operating modes and the speed reference, judged
 //! by the envelopes the manual states (manual 3.3 Pr0–Pr15, b40.2, b40.6, b41.0–b41.3; 3.6;
-//! 3.6.3 jog and wiring test; 3.6.4 positioner; appendix F).
+//! 3.6.3 jog, test profile and wiring test; 3.6.4 positioner; appendix F).
 //!
 //! Each watch reads the device round after round and judges its own samples: the value a
 //! mode asks for is reached, never exceeded, ramps are no steeper than their parameter and
@@ -14,7 +14,7 @@ use super::names;
 use super::step::{Action, Compare};
 use crate::case::Role;
 use drivespec_hpd::memory::Slot;
-use drivespec_hpd::step::{Check, Envelope, Probe, Within};
+use drivespec_hpd::step::{Check, Envelope, Probe, Shaft, Within};
 
 /// Speed tolerance (rpm): the 1 rpm resolution of Pr0 and the small overshoot and ripple of a
 /// real speed loop around its reference.
@@ -65,6 +65,24 @@ const ORIENT_RPM: i64 = 200;
 const PEAK_PERCENT: f64 = 100.0;
 /// Positioning profile: Pr51 (ms per 1000 rpm), Pr52 (rpm), revolutions.
 const PROFILE: (i64, i64, i64) = (200, 600, 5);
+/// Mode-8 test profile: the highest Pr51 (rpm) the case uses, one revolution a second.
+const TEST_TOP_RPM: i64 = 60;
+/// Mode-8 test profile: Pr52 (revolutions), even so that Pr52 / 2 is whole.
+const TEST_REVS: i64 = 2;
+/// Mode-8 test profile: the shortest Pr54 (tenths of a second) the case uses.
+const TEST_PAUSE_TENTHS: i64 = 5;
+/// Pr54 counts tenths of a second in mode 8 (manual 3.6.3).
+const US_PER_TENTH: u64 = 100_000;
+/// The case picks Pr51 so that the shaft turns at most this share of a revolution (1/8) in
+/// the longest round of reads the line allows: a factor of four below the half revolution
+/// beyond which the turns between two reads of Pr28 could not be counted.
+const TURNS_PER_ROUND: i64 = 8;
+/// A first stroke may differ from its Pr52 (or Pr52 / 2) revolutions by a quarter
+/// revolution: the travel before the first read of the watch (at most one round, an eighth of
+/// a revolution) and a real position's settling at the stroke's end (3.6.3: the profile
+/// "ensures that there is no overrun"). A wrong starting point differs by at least one
+/// revolution with Pr52 = 2.
+const STROKE_SLACK_STEPS: i64 = STEPS_PER_REV / 4;
 
 pub(crate) fn generate(g: &mut Gen) {
     let Some(m) = Motion::new(g) else {
@@ -82,6 +100,9 @@ pub(crate) fn generate(g: &mut Gen) {
     reserved_while_busy(g, &m);
     clear_increment(g, &m);
     servo_error_latch(g, &m);
+    for start in names::TEST_STARTS {
+        test_profile(g, &m, start);
+    }
     wiring_test(g, &m);
     feed_forward_defaults(g, &m);
     resets(g, &m);
@@ -98,6 +119,8 @@ struct Motion {
     main: Probe,
     position: Probe,
     reference: Probe,
+    /// Pr28, the shaft's absolute position within one revolution.
+    shaft: Probe,
     flags41: Probe,
     flags70: Probe,
     torque: Probe,
@@ -122,7 +145,7 @@ impl Motion {
             })
         };
         let slots = [
-            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 50, 51, 52, 54, 56, 57, 64, 66,
+            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 28, 50, 51, 52, 53, 54, 56, 57, 64, 66,
         ]
         .iter()
         .map(|n| Some((*n, g.slot_of(&format!("Pr{n}"))?)))
@@ -146,6 +169,7 @@ impl Motion {
             main: probe("Pr7", None)?,
             position: probe("Pr62", Some(4))?,
             reference: probe("Pr60", Some(4))?,
+            shaft: probe("Pr28", None)?,
             flags41: probe("Pb41", None)?,
             flags70: probe("Pb70", None)?,
             torque: probe(names::TORQUE_MONITOR, None)?,
@@ -1044,6 +1068,116 @@ fn servo_error_latch(g: &mut Gen, m: &Motion) {
     g.restore(&mut cb, m.pb70, "Pb70");
     g.restore(&mut cb, m.mode, "Pr31");
     g.restore_pb99(&mut cb);
+    g.push(cb);
+}
+
+/// The longest a round of `reads` reads of one word may take on the line the device was
+/// commissioned with (µs): the request and the longest answer at its bit rate, the answer
+/// delay and the message time-out of the answer window (manual 4 table, 4.1).
+fn round_us(g: &Gen, reads: u64) -> Option<u64> {
+    let line = g.baseline.line()?;
+    let bits = u64::from(g.protocol.character.bits_per_char.max(1));
+    let frame = (drivespec_hpd::MAX_FRAME as u64) * bits * 1_000_000 / u64::from(line.bps.max(1));
+    Some(reads * (2 * frame + line.answer_delay_us + line.timeout_us))
+}
+
+/// HPD-MODE-8-005, HPD-MODE-8-006: in mode 8, b70.0 = 1 with b40.2 = 1 runs the test profile
+/// from the starting point Pr53 = `start`. Mode 8 has no position register (Pr60:63 are
+/// reserved), so the shaft is followed through Pr28, its revolutions counted between rounds,
+/// and through Pr0. Judged: the speed never above Pr51; the first stroke's direction and
+/// length (Pr52, Pr52 / 2 or Pr52 revolutions at negative speed); a pause of Pr54 at 0 rpm;
+/// the next stroke the other way. The manual gives the profile no ramps and does not say how
+/// soon after b70.0 it starts: any ramp and start are accepted. Pr50 = 2 × Pr51 shows a
+/// profile run at the jog speed.
+fn test_profile(g: &mut Gen, m: &Motion, start: i64) {
+    let (Some(run), Some(round)) = (g.bit_ref("b70.0"), round_us(g, 2)) else {
+        return;
+    };
+    let per_round =
+        i64::try_from(60_000_000 / (round.max(1) * TURNS_PER_ROUND as u64)).unwrap_or(i64::MAX);
+    let rpm = TEST_TOP_RPM.min(per_round - SPEED_SLACK_RPM).max(1);
+    let tenths = TEST_PAUSE_TENTHS
+        .max(i64::try_from((4 * round).div_ceil(US_PER_TENTH)).unwrap_or(TEST_PAUSE_TENTHS));
+    let pause_us = u64::try_from(tenths).unwrap_or(0) * US_PER_TENTH;
+    let (forward, revs_x2, words) = match names::TEST_STARTS.iter().position(|s| *s == start) {
+        Some(1) => (true, TEST_REVS, "Pr52 / 2 revolutions at positive speed"),
+        Some(2) => (false, 2 * TEST_REVS, "Pr52 revolutions at negative speed"),
+        _ => (true, 2 * TEST_REVS, "Pr52 revolutions at positive speed"),
+    };
+    let stroke = revs_x2 * STEPS_PER_REV / 2;
+    let mut cb = CaseB::new(
+        format!("hpd/motion/mode-8/profile-start-{start}"),
+        format!(
+            "mode 8 with b40.2 = 1 and Pr53 = {start}: b70.0 = 1 runs the test profile at no more than Pr51 = {rpm} rpm, first {words} (Pr52 = {TEST_REVS}), then a pause of Pr54 = {tenths} tenths of a second at 0 rpm, then the other way"
+        ),
+        &[],
+    );
+    let values = [
+        (m.pr(50), 2 * rpm, "Pr50"),
+        (m.pr(51), rpm, "Pr51"),
+        (m.pr(52), TEST_REVS, "Pr52"),
+        (m.pr(53), start, "Pr53"),
+        (m.pr(54), tenths, "Pr54"),
+        (m.pr(8), RAMP_UP, "Pr8"),
+        (m.pr(9), RAMP_DOWN, "Pr9"),
+        (m.pr(10), RAMP_REVERSE, "Pr10"),
+        (m.pr(11), RAMP_DOWN, "Pr11"),
+    ];
+    setup(g, &mut cb, m, 8, &values);
+    let pb40 = pb40_with(g, m, &[names::RESERVED_REFERENCE]);
+    g.write(&mut cb, Role::Setup, m.pb40, pb40, "Pb40 (b40.2 = 1)");
+    g.bit(&mut cb, Role::Check, &run, true);
+    let shaft = Shaft {
+        position: 0,
+        speed: 1,
+        steps_per_rev: STEPS_PER_REV,
+        top_rpm: rpm + SPEED_SLACK_RPM,
+    };
+    let half = (rpm / 2).max(1);
+    let back = if forward {
+        within(1, i64::MIN, -half)
+    } else {
+        within(1, half, i64::MAX)
+    };
+    let first_us = u64::try_from(revs_x2 * 30_000_000 / rpm).unwrap_or(0);
+    let ramps_us = u64::try_from(3 * rpm * RAMP_REVERSE.max(RAMP_UP)).unwrap_or(0);
+    watch(
+        g,
+        &mut cb,
+        Role::Check,
+        "watch Pr28 and Pr0 through the first stroke and the pause until the shaft turns back",
+        vec![m.shaft, m.speed],
+        (first_us + pause_us) * TIME_FACTOR_PERCENT / 100 + TIME_EXTRA_US + ramps_us + HOLD_US,
+        vec![back],
+        vec![
+            check(
+                "HPD-MODE-8-005",
+                Envelope::Bounded {
+                    within: within(1, -rpm - SPEED_SLACK_RPM, rpm + SPEED_SLACK_RPM),
+                },
+            ),
+            check(
+                "HPD-MODE-8-006",
+                Envelope::FirstStroke {
+                    shaft,
+                    forward,
+                    min: stroke - STROKE_SLACK_STEPS,
+                    max: stroke + STROKE_SLACK_STEPS,
+                },
+            ),
+            // Less one round of reads: the speed read of a real loop settles at 0 rpm a little
+            // after its profile's reference does.
+            check(
+                "HPD-MODE-8-005",
+                Envelope::Pause {
+                    shaft,
+                    min_us: pause_us.saturating_sub(round),
+                },
+            ),
+            check("HPD-MODE-8-005", Envelope::Reverses { shaft }),
+        ],
+    );
+    cleanup(g, &mut cb, m, &values);
     g.push(cb);
 }
 

@@ -61,3 +61,6 @@ pub const DIGITAL_REFERENCE: &str = "b40.12";
 pub const TASK_SPEED_WINDOWS: &str = "speed windows manager";
 /// The appendix F task the operating modes run in (`protocol.task_slots`).
 pub const TASK_SLOW_MODE: &str = "slow operating mode";
+/// Pr53 in mode 8, the test profile's starting points (manual 3.6.3): Pr52 revolutions at
+/// positive speed, Pr52 / 2 at positive speed, Pr52 at negative speed.
+pub const TEST_STARTS: [i64; 3] = [1, 2, 3];

@@ -1,7 +1,7 @@
 //! The motor and the operating modes that turn it (manual 3.3 Pr0, Pr5–Pr15, Pr28, b40.2–b40.7,
-//! b40.12, b40.13, b41.0–b41.3; 3.6 Pr6; 3.6.3 jog and wiring test; 3.6.4 positioner;
-//! appendix F): an ideal shaft whose speed follows the speed-loop reference within the ramps,
-//! and whose position integrates the speed.
+//! b40.12, b40.13, b41.0–b41.3; 3.6 Pr6; 3.6.3 jog, test profile and wiring test; 3.6.4
+//! positioner; appendix F): an ideal shaft whose speed follows the speed-loop reference within
+//! the ramps, and whose position integrates the speed.
 //!
 //! The motor runs in the "slow operating mode" slot of appendix F (every 2.048 ms from
 //! power-up) and only while something moves or is about to. Its state lives in the
@@ -27,6 +27,8 @@ const US_PER_MIN: f64 = 60_000_000.0;
 const RPM_PER_RAMP: f64 = 1000.0;
 /// Microseconds per ramp unit (0.001 s).
 const US_PER_RAMP_UNIT: f64 = 1000.0;
+/// Microseconds per unit of the mode-8 pause Pr54 (manual 3.6.3: tenths of a second).
+const US_PER_PAUSE_UNIT: Micros = 100_000;
 
 /// How the motor uses the freedom the manual leaves it (3.3: ramps are limits; 3.6.4: the
 /// profile start is "not generated on a constant time base").
@@ -65,6 +67,7 @@ pub(super) struct MotorLayout {
     p50: Slot,
     p51: Slot,
     p52: Slot,
+    p53: Slot,
     p54: Slot,
     p56: Slot,
     p57: Slot,
@@ -115,6 +118,7 @@ impl MotorLayout {
             p50: slot(50)?,
             p51: slot(51)?,
             p52: slot(52)?,
+            p53: slot(53)?,
             p54: slot(54)?,
             p56: slot(56)?,
             p57: slot(57)?,
@@ -150,10 +154,21 @@ struct Profile {
     done: f64,
     /// Profile speed now (rpm, ≥ 0).
     speed: f64,
-    /// Acceleration and deceleration (rpm/µs), fixed at the start.
+    /// Acceleration (rpm/µs), fixed at the start.
     accel: f64,
+    /// Deceleration (rpm/µs), fixed at the start.
+    decel: f64,
     /// Steady speed (rpm), fixed at the start.
     top: f64,
+}
+
+/// The mode-8 test profile between its strokes (manual 3.6.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct TestProfile {
+    /// Direction of the next stroke: 1.0 at positive speed, -1.0 at negative speed.
+    next: f64,
+    /// When the pause at 0 rpm after a stroke ends; `None` while a stroke runs.
+    resume_at: Option<Micros>,
 }
 
 /// The motor's own state beyond the parameters.
@@ -173,6 +188,8 @@ pub(super) struct Motor {
     /// The speed reference while b40.3 freezes it.
     frozen: Option<f64>,
     profile: Option<Profile>,
+    /// The mode-8 test profile, from b70.0 until it or b40.2 drops.
+    test: Option<TestProfile>,
     /// Mode 12 has oriented the spindle since b40.2 last rose.
     oriented: bool,
     /// b70.8 as last seen (a profile starts on its rise).
@@ -207,6 +224,8 @@ impl Drive {
         let m = &self.motor;
         m.speed != 0.0
             || m.profile.is_some()
+            || m.test.is_some()
+            || self.testing()
             || self.request() != 0.0
             || self.start_pending()
             || self.wiring_pending()
@@ -236,7 +255,8 @@ impl Drive {
                     _ => 0.0,
                 }
             }
-            names::MODE_POSITIONER | names::MODE_ORIENTATION => self
+            // HPD-MODE-8-005: with b70.0 = 1 the test profile's speed.
+            names::MODE_MAINTENANCE | names::MODE_POSITIONER | names::MODE_ORIENTATION => self
                 .motor
                 .profile
                 .as_ref()
@@ -330,14 +350,20 @@ impl Drive {
         let mode = self.mode();
         let b40 = |d: &Drive, y| d.working.bit(bit(ml.pb40, y));
         let orienting = mode == names::MODE_ORIENTATION && b40(self, names::B40_RESERVED);
-        // DECISION: leaving mode 9, or mode 12 and its b40.2, abandons a profile.
-        if mode != names::MODE_POSITIONER && !orienting {
+        let testing = self.testing();
+        // DECISION: leaving mode 9, or mode 12 and its b40.2, or in mode 8 b70.0 or b40.2,
+        // abandons a profile; the speed loop then ramps the motor down.
+        if mode != names::MODE_POSITIONER && !orienting && !testing {
             self.motor.profile = None;
+        }
+        if !testing {
+            self.motor.test = None;
         }
         if !orienting {
             self.motor.oriented = false;
         }
         self.start_orientation(t);
+        self.test_stroke(t);
         let positioning = self.motor.profile.is_some();
         if positioning {
             self.profile_step(t, dt);
@@ -494,6 +520,7 @@ impl Drive {
             from: self.motor.reference,
             distance: dir * steps as f64,
             accel,
+            decel: accel,
             top,
             ..Profile::default()
         });
@@ -512,7 +539,7 @@ impl Drive {
             self.motor.profile = Some(p);
             return;
         }
-        let (accel, top) = (p.accel, p.top);
+        let (accel, decel, top) = (p.accel, p.decel, p.top);
         let total = p.distance.abs();
         let left = total - p.done;
         let per_rpm_us = STEPS_PER_REV / US_PER_MIN;
@@ -520,13 +547,13 @@ impl Drive {
         // The highest speed from which the distance left after this slot (at about the
         // present speed) can still be braked.
         let rest = (left - old * dt * per_rpm_us).max(0.0);
-        let brakeable = (2.0 * accel * rest / per_rpm_us).sqrt();
+        let brakeable = (2.0 * decel * rest / per_rpm_us).sqrt();
         // At least one slot's speed change, so that the profile ends.
         let mut new = (old + accel * dt)
             .min(top)
             .min(brakeable)
-            .max(old - accel * dt)
-            .max(accel * dt);
+            .max(old - decel * dt)
+            .max(accel.min(decel) * dt);
         let mut moved = (old + new) / 2.0 * dt * per_rpm_us;
         let finished = moved >= left;
         if finished {
@@ -543,6 +570,11 @@ impl Drive {
         };
         self.motor.position = self.motor.reference;
         self.motor.speed = dir * new;
+        // HPD-MODE-8-005: the pause of Pr54 tenths of a second at 0 rpm after a stroke.
+        let tenths = u64::try_from(self.mem_i(ml.p54)).unwrap_or(0);
+        if let Some(test) = self.motor.test.as_mut().filter(|_| finished) {
+            test.resume_at = Some(t.saturating_add(tenths.saturating_mul(US_PER_PAUSE_UNIT)));
+        }
         if finished && self.mode() == names::MODE_POSITIONER {
             // HPD-MODE-9-PROFILE-BUSY, HPD-MODE-9-START-CLEAR: both bits drop at the end.
             self.working.set_bit(bit(ml.pb70, names::B70_BUSY), false);
@@ -561,6 +593,65 @@ impl Drive {
         RPM_PER_RAMP / (f64::from(units) * US_PER_RAMP_UNIT)
             * f64::from(self.layout.motor.style.ramp_percent)
             / 100.0
+    }
+
+    /// Whether the mode-8 test profile is asked for: b70.0 = 1 with b40.2 = 1 (manual 3.6.3).
+    fn testing(&self) -> bool {
+        let ml = &self.layout.motor;
+        self.mode() == names::MODE_MAINTENANCE
+            && self.working.bit(bit(ml.pb40, names::B40_RESERVED))
+            && self.working.bit(bit(ml.pb70, names::B70_TEST_PROFILE))
+    }
+
+    /// HPD-MODE-8-005, HPD-MODE-8-006: the strokes of the mode-8 test profile. The first,
+    /// when b70.0 rises with b40.2 = 1, by the starting point Pr53 (1: Pr52 revolutions at
+    /// positive speed, 2: Pr52 / 2 at positive speed, 3: Pr52 at negative speed); each one
+    /// after it Pr52 revolutions the other way, once the pause after the last has passed. A
+    /// stroke is a trapezoid at Pr51 rpm that ends on its distance ("no overrun").
+    /// DECISION: the manual gives the profile no ramps; it accelerates on the speed loop's
+    /// ramps Pr8 (positive speed) or Pr10 (negative) and decelerates on Pr9 or Pr11, as the
+    /// motion style uses them. Any other starting point starts as 1; a distance
+    /// below 0 counts as 0.
+    fn test_stroke(&mut self, t: Micros) {
+        if !self.testing() || self.motor.profile.is_some() {
+            return;
+        }
+        let ml = self.layout.motor.clone();
+        let revs = self.mem_i(ml.p52).max(0) as f64;
+        let (dir, revs, start_at) = match self.motor.test {
+            None => {
+                let (dir, revs) = match self.mem_i(ml.p53) {
+                    names::START_HALF_FORWARD => (1.0, revs / 2.0),
+                    names::START_REVERSE => (-1.0, revs),
+                    _ => (1.0, revs),
+                };
+                (dir, revs, t.saturating_add(ml.style.start_latency_us))
+            }
+            Some(TestProfile {
+                next,
+                resume_at: Some(at),
+            }) if t >= at => (next, revs, t),
+            Some(_) => return,
+        };
+        let [up, down, up_reverse, down_reverse, _] = ml.ramps;
+        let (accel, decel) = if dir > 0.0 {
+            (up, down)
+        } else {
+            (up_reverse, down_reverse)
+        };
+        self.motor.profile = Some(Profile {
+            start_at,
+            from: self.motor.position,
+            distance: dir * revs * STEPS_PER_REV,
+            accel: self.ramp_of(accel),
+            decel: self.ramp_of(decel),
+            top: (self.mem_i(ml.p51).abs() as f64).max(1.0),
+            ..Profile::default()
+        });
+        self.motor.test = Some(TestProfile {
+            next: -dir,
+            resume_at: None,
+        });
     }
 
     /// Mode 12 waits for its orientation: b40.2 = 1 and not oriented yet.
@@ -591,6 +682,7 @@ impl Drive {
             from: shaft as f64,
             distance: distance as f64,
             accel,
+            decel: accel,
             top,
             ..Profile::default()
         });

@@ -77,6 +77,12 @@ pub(super) const B70_SERVO_ERROR: u8 = 5;
 pub(super) const B70_BUSY: u8 = 7;
 /// b70.8 in mode 9: start profile; in modes 10 and 11: axis lock (manual 3.6.4–3.6.6).
 pub(super) const B70_START: u8 = 8;
+/// Pr53 in mode 8: the test profile starts with Pr52 / 2 revolutions at positive speed
+/// (manual 3.6.3).
+pub(super) const START_HALF_FORWARD: i64 = 2;
+/// Pr53 in mode 8: the test profile starts with Pr52 revolutions at negative speed (manual
+/// 3.6.3).
+pub(super) const START_REVERSE: i64 = 3;
 /// Wiring test code 1: b40.9 = 1 or the drive disabled through the hardware (manual 3.6.3).
 pub(super) const WIRING_DISABLED: i64 = 1;
 /// Mode-9 position commands by bit of Pb70 (manual 3.6.4 b70.2, b70.10–b70.12).
