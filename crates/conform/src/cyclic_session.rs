@@ -827,36 +827,35 @@ fn first_difference<I, O, T: PartialEq + Clone>(
 /// bit, a speed) or a position more than `slack` from the step's first image; `motion` gives
 /// an image's position, speed and status word.
 fn still_violation<I, O>(
-    cycles: &[Cycle<I, O>],
+    cycles: &[Seen<'_, I, O>],
     still: &Still,
     slack: i64,
     running: u16,
     motion: impl Fn(&I) -> (i64, i64, u16),
-) -> Option<Finding> {
+) -> Option<OwnVerdict> {
     let mut images = cycles
         .iter()
         .enumerate()
         .filter(|(_, c)| c.step == still.step)
-        .filter_map(|(i, c)| c.dut.as_ref().ok().map(|d| (i, motion(d))));
+        .filter_map(|(i, c)| c.device.map(|d| (i, motion(d))));
     let (_, (start, _, _)) = images.clone().next()?;
     let (i, (position, speed, status)) = images.find(|(_, (p, v, st))| {
         st & running != 0 || *v != 0 || p.saturating_sub(start).abs() > slack
     })?;
-    Some(
-        Finding::at(
-            i,
+    Some(OwnVerdict::Broken {
+        cycle: i,
+        requirement: still.requirement.clone(),
+        what: format!(
+            "{}: in step {} the device shows position {position}, speed {speed}, the running bit {}",
+            still.what,
             still.step,
-            Some(i),
-            format!(
-                "{}: in step {} the device shows position {position} (the step began at {start}, at most {slack} from it), speed {speed}, the running bit {}",
-                still.what,
-                still.step,
-                if status & running != 0 { "set" } else { "clear" }
-            ),
-        )
-        .breaking(vec![still.requirement.clone()])
-        .leading(true),
-    )
+            if status & running != 0 { "set" } else { "clear" }
+        ),
+        allowed: format!(
+            "no run, speed 0 and the position within {} ± {slack} (where the step began)",
+            start
+        ),
+    })
 }
 
 /// " in step N" for a cycle, empty for none.
@@ -1417,17 +1416,6 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
             }
         }
         let running = self.family.running_bit();
-        // Ahead of the comparisons with the reference: a movement in the still step shows
-        // there no later than in any of them, and its own requirement leads.
-        if let Some(s) = &run.still {
-            bad.extend(still_violation(
-                &run.cycles,
-                s,
-                tol.position,
-                running,
-                F::motion,
-            ));
-        }
         let mut bounds = vec![0];
         bounds.extend(run.arrivals.iter().copied());
         bounds.push(run.cycles.len());
@@ -1972,6 +1960,15 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                 })
                 .collect();
             run.own = self.family.own_checks(case, &info.requirements, &seen);
+            if let Some(still) = &run.still {
+                run.own.extend(still_violation(
+                    &seen,
+                    still,
+                    tol.position,
+                    self.family.running_bit(),
+                    F::motion,
+                ));
+            }
         }
         self.judge(&mut run, tol);
         if F::plot(case) {
