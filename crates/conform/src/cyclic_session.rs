@@ -104,6 +104,26 @@ pub struct OpenPoint {
     pub movement: bool,
 }
 
+impl OpenPoint {
+    /// The point of a scenario's `open` setup: `bits` by number (0..15; others are ignored).
+    pub(crate) fn of_scenario(
+        requirement: &str,
+        text: &str,
+        bits: &[u16],
+        movement: bool,
+    ) -> OpenPoint {
+        OpenPoint {
+            requirement: requirement.to_owned(),
+            text: text.to_owned(),
+            bits: bits
+                .iter()
+                .filter_map(|b| 1u16.checked_shl(u32::from(*b)))
+                .fold(0, |w, b| w | b),
+            movement,
+        }
+    }
+}
+
 /// One cycle of a case run as a check of the device's own images sees it
 /// ([`CyclicFamily::own_checks`]).
 pub struct Seen<'c, I, O> {

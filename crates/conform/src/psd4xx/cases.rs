@@ -1207,16 +1207,11 @@ impl Gen<'_> {
                 Judge::Exact => EXCHANGE,
                 Judge::Motion => MOTION,
             };
-            let open = typed.setup.open.as_ref().map(|o| OpenPoint {
-                requirement: o.requirement.clone(),
-                text: o.text.clone(),
-                bits: o
-                    .bits
-                    .iter()
-                    .filter_map(|b| 1u16.checked_shl(u32::from(*b)))
-                    .fold(0, |w, b| w | b),
-                movement: o.movement,
-            });
+            let open = typed
+                .setup
+                .open
+                .as_ref()
+                .map(|o| OpenPoint::of_scenario(&o.requirement, &o.text, &o.bits, o.movement));
             if let Some(o) = &open {
                 if f.requirement(&o.requirement).is_none() {
                     self.errors.push(format!(

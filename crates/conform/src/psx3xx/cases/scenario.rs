@@ -59,16 +59,11 @@ impl Gen<'_, '_> {
                 Judge::Exact => (EXACT, false),
                 Judge::Motion => (MOTION, true),
             };
-            let open = typed.setup.open.as_ref().map(|o| OpenPoint {
-                requirement: o.requirement.clone(),
-                text: o.text.clone(),
-                bits: o
-                    .bits
-                    .iter()
-                    .filter_map(|b| 1u16.checked_shl(u32::from(*b)))
-                    .fold(0, |w, b| w | b),
-                movement: false,
-            });
+            let open = typed
+                .setup
+                .open
+                .as_ref()
+                .map(|o| OpenPoint::of_scenario(&o.requirement, &o.text, &o.bits, false));
             if let Some(o) = &open {
                 if self.family.requirement(&o.requirement).is_none() {
                     self.errors.push(format!(
