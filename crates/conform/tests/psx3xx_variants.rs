@@ -37,7 +37,6 @@ fn every_psx3xx_legal_variant_passes() {
 fn every_psx3xx_legal_variant_with_a_snap_brake_passes() {
     use drivespec_implementations::psx3xx_mutants::SNAP_BRAKE_MODEL;
     use drivespec_sim::reference::BrakeKind;
-    let brake = Some((SNAP_BRAKE_MODEL, BrakeKind::Snap));
     let settings = Settings {
         model: Some(SNAP_BRAKE_MODEL.to_owned()),
         brake: Some(BrakeKind::Snap),
@@ -46,7 +45,11 @@ fn every_psx3xx_legal_variant_with_a_snap_brake_passes() {
     let suite = Psx3xxSuite::new(spec(), &settings).unwrap();
     let mut problems = Vec::new();
     for (name, kind) in variants() {
-        let server = Server::new(name, "psx3xx", Box::new(Variant::with_brake(kind, brake)));
+        let server = Server::new(
+            name,
+            "psx3xx",
+            Box::new(Variant::with_brake(kind, SNAP_BRAKE_MODEL, BrakeKind::Snap).unwrap()),
+        );
         let mut session = suite.session(Box::new(LocalPeer::new(name, server)));
         let failed = failures(suite.cases(), &mut session);
         let ids: Vec<&str> = failed.iter().map(|(id, _)| id.as_str()).collect();

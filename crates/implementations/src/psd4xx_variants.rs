@@ -255,6 +255,8 @@ fn running_bit() -> u16 {
     bit("status", "Drive is running")
 }
 
+/// The mask of the built-in spec's bit `name` of `field` (callers name bits of the spec's
+/// PSD4xx status and control words).
 fn bit(field: &str, name: &str) -> u16 {
     let b = spec().family(FamilyId::Psd4xx).bitfield(field).unwrap();
     1 << b.bits.iter().find(|x| x.name == name).unwrap().bit

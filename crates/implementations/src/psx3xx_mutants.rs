@@ -146,6 +146,7 @@ fn error_name(
 impl Mutant<'static> {
     pub fn new(kind: Kind) -> Mutant<'static> {
         let (model, brake) = kind.brake().unzip();
+        // The default model, or the fixed model that may have the kind's brake (`Kind::brake`).
         let reference = drivespec_sim::reference::psx3xx(spec(), model, brake).unwrap();
         Mutant {
             drive: reference.drive,

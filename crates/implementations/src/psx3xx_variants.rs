@@ -9,6 +9,7 @@ use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::Request;
 use drivespec_psx3xx::model::{BrakeKind, Drive};
 use drivespec_psx3xx::Output;
+use drivespec_sim::reference::ReferenceError;
 use drivespec_spec::FamilyId;
 use std::collections::VecDeque;
 
@@ -45,16 +46,25 @@ pub struct Variant<'s> {
 impl Variant<'static> {
     /// The variant `kind`.
     pub fn new(kind: Kind) -> Variant<'static> {
-        Variant::with_brake(kind, None)
+        // The default model without brake, which the built-in spec always builds.
+        let reference = drivespec_sim::reference::psx3xx(spec(), None, None).unwrap();
+        Variant::on(kind, reference.drive)
     }
 
-    /// The variant `kind` built on `model` with its brake option (manual 5.11–5.13), or on
-    /// the default model without brake.
-    pub fn with_brake(kind: Kind, brake: Option<(&str, BrakeKind)>) -> Variant<'static> {
-        let (model, brake) = brake.unzip();
-        let reference = drivespec_sim::reference::psx3xx(spec(), model, brake).unwrap();
+    /// The variant `kind` built on `model` with its brake option (manual 5.11–5.13); an
+    /// unknown model or a brake the model cannot have is the reference's error.
+    pub fn with_brake(
+        kind: Kind,
+        model: &str,
+        brake: BrakeKind,
+    ) -> Result<Variant<'static>, ReferenceError> {
+        let reference = drivespec_sim::reference::psx3xx(spec(), Some(model), Some(brake))?;
+        Ok(Variant::on(kind, reference.drive))
+    }
+
+    fn on(kind: Kind, drive: Drive<'static>) -> Variant<'static> {
         Variant {
-            drive: reference.drive,
+            drive,
             kind,
             applied: None,
             pending: VecDeque::new(),
