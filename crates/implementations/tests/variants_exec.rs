@@ -132,7 +132,7 @@ fn workers() -> usize {
 }
 
 #[test]
-#[ignore = "19 variants × 5 runs of every case take about 15 minutes of real time on 2 cores, too long for every CI run; run with --run-ignored"]
+#[ignore = "19 variants × 5 runs of every case take about 32 minutes of real time on 2 cores (1,889 s measured), too long for every CI run; run with --run-ignored"]
 fn every_hpd_variant_over_exec_passes_five_runs_in_a_row() {
     every_variant_five_runs(FamilyId::Hpd, workers());
 }
@@ -144,13 +144,13 @@ fn every_hpd_variant_over_exec_passes_the_line_cases() {
 }
 
 #[test]
-#[ignore = "15 variants × 5 runs take about 5 minutes of real time on 2 cores (327 s measured), too long for every CI run; run with --run-ignored"]
+#[ignore = "15 variants × 5 runs take 2 to 5 minutes of real time on 2 cores (136 s and 327 s measured), too long for every CI run; run with --run-ignored"]
 fn every_psd4xx_variant_over_exec_passes_five_runs_in_a_row() {
     every_variant_five_runs(FamilyId::Psd4xx, workers());
 }
 
 #[test]
-#[ignore = "6 variants × 5 runs take about 1.5 minutes of real time with nothing beside them, too long for every CI run; run with --run-ignored"]
+#[ignore = "6 variants × 5 runs take about a minute of real time with nothing beside them (56 s measured), too long for every CI run; run with --run-ignored"]
 fn every_psx3xx_variant_over_exec_passes_five_runs_in_a_row() {
     every_variant_five_runs(FamilyId::Psx3xx, workers());
 }

@@ -67,6 +67,30 @@ pub struct PsxCase {
     pub not_applicable: Option<String>,
 }
 
+impl PsxCase {
+    /// A case judged exactly, cycle by cycle, starting from `start`.
+    pub fn exact(start: Output, steps: Vec<StepDef>) -> Self {
+        Self::judged(start, steps, EXACT, false)
+    }
+
+    /// A motion case, judged by its envelope and plotted, starting from `start`.
+    pub fn motion(start: Output, steps: Vec<StepDef>) -> Self {
+        Self::judged(start, steps, MOTION, true)
+    }
+
+    fn judged(start: Output, steps: Vec<StepDef>, tol: Tolerance, plot: bool) -> Self {
+        Self {
+            start,
+            steps,
+            tol,
+            plot,
+            open: None,
+            still: None,
+            not_applicable: None,
+        }
+    }
+}
+
 /// A process output in the format of `out`, then one cycle (manual 3.3.1).
 pub(crate) fn pd_out(out: Output) -> Step {
     match out {
@@ -218,15 +242,7 @@ impl<'a, 's> Gen<'a, 's> {
             format!("psx3xx/{id}"),
             &reqs,
             description.to_owned(),
-            PsxCase {
-                start: self.idle(self.rules.default_format()),
-                steps,
-                tol: EXACT,
-                plot: false,
-                open: None,
-                still: None,
-                not_applicable: None,
-            },
+            PsxCase::exact(self.idle(self.rules.default_format()), steps),
         );
     }
 
@@ -236,15 +252,7 @@ impl<'a, 's> Gen<'a, 's> {
             format!("psx3xx/{id}"),
             &reqs,
             description.to_owned(),
-            PsxCase {
-                start: self.idle(self.rules.default_format()),
-                steps,
-                tol: MOTION,
-                plot: true,
-                open: None,
-                still: None,
-                not_applicable: None,
-            },
+            PsxCase::motion(self.idle(self.rules.default_format()), steps),
         );
     }
 
@@ -441,19 +449,14 @@ impl<'a, 's> Gen<'a, 's> {
                 format!("psx3xx/isdu/read/{}", p.id),
                 &reqs,
                 format!("ISDU read of {} ({}) after power-on", p.id, p.name),
-                PsxCase {
-                    start: self.idle(self.rules.default_format()),
-                    steps: vec![step(
+                PsxCase::exact(
+                    self.idle(self.rules.default_format()),
+                    vec![step(
                         Role::Check,
                         format!("ISDU read {index}.{subindex}"),
                         Step::IsduRead { index, subindex },
                     )],
-                    tol: EXACT,
-                    plot: false,
-                    open: None,
-                    still: None,
-                    not_applicable: None,
-                },
+                ),
             );
             if p.access == Access::R {
                 let len = width(p.data_type).unwrap_or(1);
@@ -463,9 +466,9 @@ impl<'a, 's> Gen<'a, 's> {
                     format!("psx3xx/isdu/read-only/{}", p.id),
                     &reqs,
                     format!("a write to the read-only {} ({}) is refused", p.id, p.name),
-                    PsxCase {
-                        start: self.idle(1),
-                        steps: vec![
+                    PsxCase::exact(
+                        self.idle(1),
+                        vec![
                             step(
                                 Role::Check,
                                 format!("ISDU write {index}.{subindex} with {len} zero octet(s)"),
@@ -481,12 +484,7 @@ impl<'a, 's> Gen<'a, 's> {
                                 Step::IsduRead { index, subindex },
                             ),
                         ],
-                        tol: EXACT,
-                        plot: false,
-                        open: None,
-                        still: None,
-                        not_applicable: None,
-                    },
+                    ),
                 );
             }
             if p.access.writable() {
@@ -583,15 +581,7 @@ impl<'a, 's> Gen<'a, 's> {
                     p.name,
                     if beyond { ": refused, value kept" } else { "" }
                 ),
-                PsxCase {
-                    start: self.idle(self.rules.default_format()),
-                    steps,
-                    tol: EXACT,
-                    plot: false,
-                    open: None,
-                    still: None,
-                    not_applicable: None,
-                },
+                PsxCase::exact(self.idle(self.rules.default_format()), steps),
             );
         }
     }
@@ -876,17 +866,8 @@ impl<'a, 's> Gen<'a, 's> {
                 ),
                 oneshot,
             );
-            let volatile: Vec<StepDef> = [
-                self.read(&g.guard),
-                self.write(Role::Check, &g.guard, allow_value),
-                self.save(Role::Check),
-                self.saved(Role::Check),
-                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
-                self.read(&g.guard),
-            ]
-            .into_iter()
-            .flatten()
-            .collect();
+            let mut volatile: Vec<StepDef> = self.read(&g.guard).into_iter().collect();
+            volatile.extend(self.saved_across_power_cycle(&g.guard, allow_value));
             self.case(
                 &format!("guard/{}/volatile", g.guard),
                 &[&volatile_req, "PSX-PAR-NOT-SAVED"],
@@ -897,6 +878,21 @@ impl<'a, 's> Gen<'a, 's> {
                 volatile,
             );
         }
+    }
+
+    /// Write `value` to `id`, save (ISDU 193 = 1), wait for the save to finish, cycle the
+    /// power and read `id` back (manual 3.1).
+    fn saved_across_power_cycle(&mut self, id: &str, value: i64) -> Vec<StepDef> {
+        [
+            self.write(Role::Check, id, value),
+            self.save(Role::Check),
+            self.saved(Role::Check),
+            Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
+            self.read(id),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 
     /// The write that saves the working values (ISDU 193 = 1, PSX-CMD-014), from the spec's
@@ -1078,16 +1074,7 @@ impl<'a, 's> Gen<'a, 's> {
             "a written value without a save is lost in a power cycle",
             lost,
         );
-        let kept: Vec<StepDef> = [
-            self.write(Role::Check, probe, probe_value),
-            self.save(Role::Check),
-            self.saved(Role::Check),
-            Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
-            self.read(probe),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+        let kept = self.saved_across_power_cycle(probe, probe_value);
         self.case(
             "command/saved-kept",
             &["PSX-CMD-018", "PSX-PAR-SAVED", "PSX-CMD-014", "PSX-CMD-017"],
@@ -1110,16 +1097,7 @@ impl<'a, 's> Gen<'a, 's> {
             else {
                 continue;
             };
-            let steps: Vec<StepDef> = [
-                self.write(Role::Check, &p.id, v),
-                self.save(Role::Check),
-                self.saved(Role::Check),
-                Some(step(Role::Check, "power cycle", env(Env::PowerCycle))),
-                self.read(&p.id),
-            ]
-            .into_iter()
-            .flatten()
-            .collect();
+            let steps = self.saved_across_power_cycle(&p.id, v);
             self.case(
                 &format!("command/not-saved/{}", p.id),
                 &["PSX-PAR-NOT-SAVED"],

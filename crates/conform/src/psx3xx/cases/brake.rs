@@ -4,7 +4,7 @@
 //! option the run declares (`--brake`): the readjustment cases (5.4) only without a brake
 //! that has no adjustment function, PSX-ADJ-010 only with one.
 
-use super::{env, isdu, step, Gen, PsxCase, StepDef, Still, MOTION, SETTLE};
+use super::{env, isdu, step, Gen, PsxCase, StepDef, Still, SETTLE};
 use crate::case::Role;
 use crate::cyclic::Env;
 
@@ -138,13 +138,8 @@ impl Gen<'_, '_> {
                 &[NO_READJUSTMENT.to_owned()],
                 description.to_owned(),
                 PsxCase {
-                    start: self.idle(self.rules.default_format()),
-                    steps,
-                    tol: MOTION,
-                    plot: true,
-                    open: None,
                     still: Some(still),
-                    not_applicable: None,
+                    ..PsxCase::motion(self.idle(self.rules.default_format()), steps)
                 },
             );
         }

@@ -3,7 +3,7 @@
 //! values and quantities the steps name from the spec and the reference drive (manual
 //! 3.3–3.5, 4, 5).
 
-use super::{step, Gen, OpenPoint, PsxCase, StepDef, EXACT, MOTION, RUN_MAX};
+use super::{step, Gen, OpenPoint, PsxCase, StepDef, RUN_MAX};
 use crate::case::Role;
 use drivespec_psx3xx::scenario::{Action, Control, Judge, Quantity, ScenarioStep, Setup, StepRole};
 use drivespec_psx3xx::step::Step;
@@ -55,9 +55,10 @@ impl Gen<'_, '_> {
                     ));
                 }
             }
-            let (tol, plot) = match typed.setup.judge {
-                Judge::Exact => (EXACT, false),
-                Judge::Motion => (MOTION, true),
+            let start = self.idle(self.rules.default_format());
+            let judged = match typed.setup.judge {
+                Judge::Exact => PsxCase::exact(start, steps),
+                Judge::Motion => PsxCase::motion(start, steps),
             };
             let open = typed
                 .setup
@@ -72,15 +73,7 @@ impl Gen<'_, '_> {
                     ));
                 }
             }
-            let case = PsxCase {
-                start: self.idle(self.rules.default_format()),
-                steps,
-                tol,
-                plot,
-                open,
-                still: None,
-                not_applicable: None,
-            };
+            let case = PsxCase { open, ..judged };
             self.push(
                 format!("psx3xx/{}", record.id),
                 &record.requirements,

@@ -2,7 +2,7 @@
 //! start state and steps, read through the family [`VectorStep`] type, become the inputs of one
 //! motion case; the device must show what the reference shows (manual 3.3, 4.4–4.6, 5.9–5.14).
 
-use super::{address, env, pd_out, step, Gen, PsxCase, StepDef, MOTION, SETTLE};
+use super::{address, env, pd_out, step, Gen, PsxCase, StepDef, SETTLE};
 use crate::case::Role;
 use crate::cyclic::Env;
 use drivespec_positioner::script::kebab;
@@ -68,15 +68,7 @@ impl Gen<'_, '_> {
                     format!("psx3xx/sequence/{}", v.id),
                     &reqs,
                     v.description.clone(),
-                    PsxCase {
-                        start,
-                        steps,
-                        tol: MOTION,
-                        plot: true,
-                        open: None,
-                        still: None,
-                        not_applicable: None,
-                    },
+                    PsxCase::motion(start, steps),
                 );
             }
         }
