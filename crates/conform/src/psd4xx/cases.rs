@@ -234,6 +234,18 @@ fn step(role: Role, text: impl Into<String>, action: Step) -> StepDef {
     }
 }
 
+/// The control voltage switched off and on, then five cycles to settle (3.3 par 96).
+fn power_cycle(steps: &mut Vec<StepDef>) {
+    steps.push(step(
+        Role::Check,
+        "power cycle",
+        Step::Env {
+            env: Env::PowerCycle.to_string(),
+        },
+    ));
+    steps.push(step(Role::Check, "settle", Step::Hold { cycles: 5 }));
+}
+
 impl Gen<'_> {
     fn push(&mut self, id: String, reqs: &[&str], description: String, case: PsdCase) {
         let mut requirements: Vec<String> = Vec::new();
@@ -641,14 +653,7 @@ impl Gen<'_> {
                 },
             );
             self.write_pkw(&mut steps, 96, 1);
-            steps.push(step(
-                Role::Check,
-                "power cycle",
-                Step::Env {
-                    env: Env::PowerCycle.to_string(),
-                },
-            ));
-            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 5 }));
+            power_cycle(&mut steps);
             self.exchange(
                 &mut steps,
                 Role::Check,
@@ -1398,14 +1403,7 @@ impl Gen<'_> {
                 },
             ));
             self.exchange(&mut steps, Role::Check, "read par 44", read44);
-            steps.push(step(
-                Role::Check,
-                "power cycle",
-                Step::Env {
-                    env: Env::PowerCycle.to_string(),
-                },
-            ));
-            steps.push(step(Role::Check, "settle", Step::Hold { cycles: 5 }));
+            power_cycle(&mut steps);
             self.exchange(
                 &mut steps,
                 Role::Check,
