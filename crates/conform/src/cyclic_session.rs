@@ -1535,7 +1535,7 @@ impl<'a, 's, F: CyclicFamily<'s>> CyclicSession<'a, F> {
                         run.cycles.get(x.at).map_or(0, |c| c.step),
                         x.theirs,
                         format!(
-                            "status bit {bit}: change {} makes it {} on the device{}, {} on the reference{}",
+                            "status bit {bit}, change {}: {} on the device{}, {} on the reference{}",
                             x.change,
                             what(x.device),
                             step_of(&run.cycles, Some(x.at)),
