@@ -2,7 +2,7 @@
 //! operating modes or the status it reports about them (manual 3.3, 3.6), for the
 //! `hpd/motion` checks (`hpd_mutants.rs`).
 
-use crate::spec;
+use crate::{hpd_target, spec};
 use drivespec_hpd::model::{Drive, DriveConfig, MotionStyle, Output};
 use drivespec_hpd::params::Target;
 use drivespec_hpd::{parse, Data, FrameRules, Message};
@@ -73,10 +73,6 @@ pub struct MotionMutant {
     plc_read: bool,
 }
 
-fn target(name: &str) -> Target<'static> {
-    Target::parse(spec().family(FamilyId::Hpd), name).unwrap()
-}
-
 /// Serial address of parameter `id`.
 fn addr(id: &str) -> u8 {
     let a = spec()
@@ -109,7 +105,7 @@ impl MotionMutant {
     }
 
     fn value(&self, name: &str) -> i64 {
-        self.inner.value(&target(name)).unwrap_or(0)
+        self.inner.value(&hpd_target(name)).unwrap_or(0)
     }
 
     fn mode(&self) -> i64 {
@@ -138,7 +134,7 @@ impl MotionMutant {
         }
         match self.kind {
             Kind::ReverseIgnored if mode9 && self.sets_b70(bytes, 8) => {
-                let dir = target("b70.4");
+                let dir = hpd_target("b70.4");
                 let kept = self.value("b70.4");
                 let _ = self.inner.set_value(now, &dir, 0);
                 self.inner.handle_rx(now, bytes);
@@ -146,7 +142,7 @@ impl MotionMutant {
                 let _ = self.inner.set_value(now + 2_048, &dir, kept);
             }
             Kind::ShortProfile if mode9 && self.sets_b70(bytes, 8) => {
-                let inc = target("Pr64:65");
+                let inc = hpd_target("Pr64:65");
                 let kept = self.inner.value(&inc).unwrap_or(0);
                 let _ = self.inner.set_value(now, &inc, kept * 98 / 100);
                 self.inner.handle_rx(now, bytes);
@@ -167,7 +163,7 @@ impl MotionMutant {
                 let kept: Vec<(Target<'static>, i64)> = ["Pr60:61", "Pr62:63", "Pr64:65"]
                     .iter()
                     .map(|id| {
-                        let t = target(id);
+                        let t = hpd_target(id);
                         let v = self.inner.value(&t).unwrap_or(0);
                         (t, v)
                     })
@@ -181,7 +177,7 @@ impl MotionMutant {
                 self.inner.handle_rx(now, bytes);
                 if let Ok(Message::WriteParam { par, data, .. }) = parse(&self.rules, bytes) {
                     if par == addr("Pr52") && data.len() == 2 {
-                        let t = target("Pr52");
+                        let t = hpd_target("Pr52");
                         let _ = self.inner.set_value(now, &t, t.value(&data));
                     }
                 }
@@ -191,7 +187,7 @@ impl MotionMutant {
             {
                 let kept: Vec<(Target<'static>, i64)> = ["Pr60:61", "Pr62:63"]
                     .iter()
-                    .map(|id| (target(id), self.value(id)))
+                    .map(|id| (hpd_target(id), self.value(id)))
                     .collect();
                 self.inner.handle_rx(now, bytes);
                 for (t, v) in kept {
@@ -199,7 +195,7 @@ impl MotionMutant {
                 }
             }
             Kind::ResetWhileLocked if self.mode() == 10 && self.sets_b70(bytes, 10) => {
-                let lock = target("b70.8");
+                let lock = hpd_target("b70.8");
                 let kept = self.value("b70.8");
                 let _ = self.inner.set_value(now, &lock, 0);
                 self.inner.handle_rx(now, bytes);
@@ -214,13 +210,13 @@ impl MotionMutant {
                     Kind::TestNoPause => ("Pr54", 0),
                     _ => ("Pr51", self.value("Pr50")),
                 };
-                let _ = self.inner.set_value(now, &target(name), v);
+                let _ = self.inner.set_value(now, &hpd_target(name), v);
                 self.inner.handle_rx(now, bytes);
             }
             Kind::DefaultsKeepFlags
                 if [9, 10, 11].contains(&self.mode()) && self.sets_b99_11(bytes) =>
             {
-                let flags = target("Pb70");
+                let flags = hpd_target("Pb70");
                 let kept = self.value("Pb70");
                 self.inner.handle_rx(now, bytes);
                 let _ = self.inner.set_value(now, &flags, kept);
@@ -248,7 +244,7 @@ impl MotionMutant {
         }
         let testing = self.mode() == 8 && self.value("b70.3") == 1;
         if self.testing && !testing && self.value("Pr57") == 0 {
-            let _ = self.inner.set_value(now, &target("Pr56"), 0);
+            let _ = self.inner.set_value(now, &hpd_target("Pr56"), 0);
         }
         self.testing = testing;
     }

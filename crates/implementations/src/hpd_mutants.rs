@@ -2,7 +2,7 @@
 //! or an erratum reading other than the adopted one), shared by the mutation test
 //! (`hpd_mutants.rs`) and the fuzzer tests (`crates/fuzz/tests/fuzz_*.rs`).
 
-use crate::spec;
+use crate::{hpd_target, spec};
 use drivespec_hpd::model::{Drive, DriveConfig, Output};
 use drivespec_hpd::params::Target;
 use drivespec_hpd::{decode, parse, AckEnd, Data, FrameRules, Message, MessageKind, Status};
@@ -284,12 +284,11 @@ impl Mutant {
                         .and_then(|p| p.address)
                         == Some(u32::from(par)) =>
             {
-                let family = spec().family(FamilyId::Hpd);
-                let busy = Target::parse(family, "b70.7").unwrap();
+                let busy = hpd_target("b70.7");
                 let running = self.inner.value(&busy).unwrap_or(0) != 0;
                 self.inner.handle_rx(now, bytes);
                 if running {
-                    let mode = Target::parse(family, "Pr31").unwrap();
+                    let mode = hpd_target("Pr31");
                     let _ = self.inner.set_value(now, &mode, 0);
                 }
                 return;
@@ -326,8 +325,7 @@ impl Mutant {
             (Kind::PlcWritableWhileRunning, Some(Message::WritePlc { addr, .. }))
                 if addr == own =>
             {
-                let family = spec().family(FamilyId::Hpd);
-                let run = Target::parse(family, "b99.13").unwrap();
+                let run = hpd_target("b99.13");
                 let running = self.inner.value(&run).unwrap_or(0);
                 let _ = self.inner.set_value(now, &run, 0);
                 self.inner.handle_rx(now, bytes);
@@ -365,7 +363,7 @@ impl Mutant {
     /// its input (the k-th FIN input k, inverted when n bit 1 is set) into b40.y or b70.y.
     fn late_fins(&mut self, now: Micros) {
         let family = spec().family(FamilyId::Hpd);
-        let run = Target::parse(family, "b99.13").unwrap();
+        let run = hpd_target("b99.13");
         if self.inner.value(&run).unwrap_or(0) == 0 {
             return;
         }
@@ -384,7 +382,7 @@ impl Mutant {
             if !other_before {
                 continue;
             }
-            let input = Target::parse(family, &format!("b90.{k}")).unwrap();
+            let input = hpd_target(&format!("b90.{k}"));
             let level = self.inner.value(&input).unwrap_or(0) != 0;
             let param = if n & 1 == 0 { 40 } else { 70 };
             let Ok(out) = Target::parse(family, &format!("b{param}.{y}")) else {
@@ -502,14 +500,14 @@ impl SimDevice for Mutant {
         self.rx(now, bytes);
     }
     fn advance(&mut self, now: Micros) {
-        let timer = Target::parse(spec().family(FamilyId::Hpd), "Pr93").unwrap();
+        let timer = hpd_target("Pr93");
         let before = self.inner.value(&timer).unwrap_or(0);
         self.inner.advance(now);
         if self.kind == Kind::FinAnywhere {
             self.late_fins(now);
         }
         if self.kind == Kind::ServoErrorNotLatched && self.mode() == 9 {
-            let servo = Target::parse(spec().family(FamilyId::Hpd), "b70.5").unwrap();
+            let servo = hpd_target("b70.5");
             if self.inner.value(&servo).unwrap_or(0) == 0 {
                 self.servo_since = None;
             } else {
@@ -521,9 +519,8 @@ impl SimDevice for Mutant {
             }
         }
         if self.kind == Kind::TorqueBeyondPeak {
-            let family = spec().family(FamilyId::Hpd);
-            let speed = Target::parse(family, "Pr0").unwrap();
-            let torque = Target::parse(family, "Pr35").unwrap();
+            let speed = hpd_target("Pr0");
+            let torque = hpd_target("Pr35");
             let turning = self.inner.value(&speed).unwrap_or(0) != 0;
             let _ = self
                 .inner
@@ -563,7 +560,7 @@ impl SimDevice for Mutant {
     }
     fn power_cycle(&mut self, now: Micros) {
         self.held.clear();
-        let flags = Target::parse(spec().family(FamilyId::Hpd), "Pb91").unwrap();
+        let flags = hpd_target("Pb91");
         let kept = self.inner.value(&flags).unwrap_or(0);
         self.inner.power_cycle(now);
         if self.kind == Kind::KeepsVolatileFlags {

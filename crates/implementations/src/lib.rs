@@ -41,11 +41,32 @@ pub mod psx3xx_mutants;
 pub mod psx3xx_variants;
 pub mod serve;
 
-use drivespec_spec::Spec;
+use drivespec_hpd::params::Target;
+use drivespec_spec::{Bitfield, FamilyId, Spec};
 use std::sync::OnceLock;
 
 /// The built-in spec, loaded once.
 pub fn spec() -> &'static Spec {
     static SPEC: OnceLock<Spec> = OnceLock::new();
     SPEC.get_or_init(|| Spec::builtin().unwrap())
+}
+
+/// HPD parameter or bit `name` (`Pr31`, `b70.7`) of the built-in spec; callers name entries
+/// of its tables, so the lookup cannot fail on the spec the fixtures are built from.
+pub fn hpd_target(name: &str) -> Target<'static> {
+    Target::parse(spec().family(FamilyId::Hpd), name).expect("a name of the built-in HPD tables")
+}
+
+/// The mask of bit `name` of `field`; callers name bits of the built-in spec's status and
+/// control words, so the lookup cannot fail on the spec the fixtures are built from.
+pub fn mask(field: Option<&Bitfield>, name: &str) -> u16 {
+    field
+        .and_then(|f| f.bits.iter().find(|b| b.name == name))
+        .and_then(|b| 1u16.checked_shl(b.bit))
+        .expect("a bit of the built-in spec's status and control words")
+}
+
+/// The mask of the PSD4xx bit `name` of `field` (`status`, `control`) in the built-in spec.
+pub fn psd4xx_bit(field: &str, name: &str) -> u16 {
+    mask(spec().family(FamilyId::Psd4xx).bitfield(field), name)
 }

@@ -2,17 +2,12 @@
 //! `psd4xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
 //! test (`psd4xx_mutants.rs`) and the fuzzer test (`crates/fuzz/tests/fuzz_psd4xx.rs`).
 
-use crate::spec;
+use crate::{psd4xx_bit, spec};
 use drivespec_cyclic::{CyclicDevice, Env};
 use drivespec_positioner::Micros;
 use drivespec_psd4xx::model::{Drive, RecordAnswer, RecordFailure, RecordRequest};
 use drivespec_psd4xx::{Input, Output, PkwRequest, Request};
 use drivespec_spec::FamilyId;
-
-fn bit(field: &str, name: &str) -> u16 {
-    let b = spec().family(FamilyId::Psd4xx).bitfield(field).unwrap();
-    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
-}
 
 /// The planted deviations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,8 +139,8 @@ impl CyclicDevice<'static> for Mutant {
         let pkw = rules.pkw();
         let mut out = Output::parse(&rules, image).map_err(|e| e.to_string())?;
         let original = out;
-        let release = bit("control", "Release");
-        let transfer = bit("control", "Transfer target value");
+        let release = psd4xx_bit("control", "Release");
+        let transfer = psd4xx_bit("control", "Transfer target value");
         match self.kind {
             Kind::PkwRefresh if self.last_pkw == Some(out.pkw) => {
                 let mut idle = out;
@@ -153,7 +148,9 @@ impl CyclicDevice<'static> for Mutant {
                 let b = idle.to_bytes(&rules).unwrap();
                 self.drive.cycle(now, &b)?;
             }
-            Kind::LoopInverted => out.control ^= bit("control", "Run without reference loop"),
+            Kind::LoopInverted => {
+                out.control ^= psd4xx_bit("control", "Run without reference loop")
+            }
             Kind::ReadjustAfterAbort => {
                 if self.running && self.last_control & release != 0 && out.control & release == 0 {
                     self.aborted = true;
@@ -203,8 +200,10 @@ impl CyclicDevice<'static> for Mutant {
             {
                 input.pkw.pwe = codes.out_of_range.0;
             }
-            Kind::Bits0And10 if input.status & bit("status", "Target position reached") != 0 => {
-                input.status |= bit("status", "Positioning error (obstruction)");
+            Kind::Bits0And10
+                if input.status & psd4xx_bit("status", "Target position reached") != 0 =>
+            {
+                input.status |= psd4xx_bit("status", "Positioning error (obstruction)");
             }
             Kind::EchoMissing => {
                 let write = pkw
@@ -218,7 +217,7 @@ impl CyclicDevice<'static> for Mutant {
                 }
             }
             Kind::ToggleNotEchoed => {
-                input.status &= !bit("status", "Toggle bit");
+                input.status &= !psd4xx_bit("status", "Toggle bit");
             }
             Kind::RangeIgnored
                 if input.pkw.ak == cannot && input.pkw.pwe == codes.out_of_range.0 =>
@@ -240,7 +239,7 @@ impl CyclicDevice<'static> for Mutant {
             }
             Kind::SpeedSignInverted => input.speed = input.speed.wrapping_neg(),
             Kind::ObstructionBitMissing => {
-                input.status &= !bit("status", "Positioning error (obstruction)")
+                input.status &= !psd4xx_bit("status", "Positioning error (obstruction)")
             }
             Kind::StandstillWritesAccepted
                 if input.pkw.ak == cannot && input.pkw.pwe == codes.operating_state.0 =>
@@ -253,17 +252,17 @@ impl CyclicDevice<'static> for Mutant {
                     self.transferred = Some(original.target);
                 }
                 let window = self.drive.parameter(44).unwrap_or(0);
-                let still = input.status & bit("status", "Drive is running") == 0;
+                let still = input.status & psd4xx_bit("status", "Drive is running") == 0;
                 if let Some(t) = self.transferred.filter(|_| still) {
                     if (i64::from(input.actual) - i64::from(t)).abs() <= 10 * window {
-                        input.status |= bit("status", "Target position reached");
+                        input.status |= psd4xx_bit("status", "Target position reached");
                     }
                 }
             }
             Kind::TemperatureWithoutHysteresis => {
                 let limit = self.drive.parameter(91).unwrap_or(80);
                 if self.temperature.is_some_and(|c| i64::from(c) <= limit) {
-                    input.status &= !bit("status", "Temperature too high");
+                    input.status &= !psd4xx_bit("status", "Temperature too high");
                 }
             }
             Kind::ErrorResetByCommand => {
@@ -271,24 +270,27 @@ impl CyclicDevice<'static> for Mutant {
                     self.error_cleared = true;
                 }
                 if self.error_cleared {
-                    input.status &= !bit("status", "Error");
+                    input.status &= !psd4xx_bit("status", "Error");
                 }
             }
-            Kind::LowerLimitBitMissing => input.status &= !bit("status", "Negative range limit"),
+            Kind::LowerLimitBitMissing => {
+                input.status &= !psd4xx_bit("status", "Negative range limit")
+            }
             Kind::SpeedJumps
-                if input.status & bit("status", "Drive is running") != 0 && input.speed != 0 =>
+                if input.status & psd4xx_bit("status", "Drive is running") != 0
+                    && input.speed != 0 =>
             {
                 input.speed = input.speed.signum() * input.speed.abs().max(50);
             }
             Kind::ReadjustAfterAbort
-                if input.status & bit("status", "Target position reached") != 0 =>
+                if input.status & psd4xx_bit("status", "Target position reached") != 0 =>
             {
                 self.aborted = false;
             }
             Kind::LimitBitsSwapped => {
                 let (up, down) = (
-                    bit("status", "Positive range limit"),
-                    bit("status", "Negative range limit"),
+                    psd4xx_bit("status", "Positive range limit"),
+                    psd4xx_bit("status", "Negative range limit"),
                 );
                 let (u, d) = (input.status & up != 0, input.status & down != 0);
                 input.status &= !(up | down);
@@ -296,7 +298,7 @@ impl CyclicDevice<'static> for Mutant {
             }
             _ => {}
         }
-        self.running = input.status & bit("status", "Drive is running") != 0;
+        self.running = input.status & psd4xx_bit("status", "Drive is running") != 0;
         self.last_control = original.control;
         self.last_pkw = Some(original.pkw);
         if original.pkw != PkwRequest::default() {
@@ -342,7 +344,7 @@ impl CyclicDevice<'static> for Mutant {
                 if self.kind == Kind::ReadjustAfterAbort
                     && self.aborted
                     && !self.running
-                    && self.last_control & bit("control", "Release") != 0
+                    && self.last_control & psd4xx_bit("control", "Release") != 0
                     && self.drive.parameter(47) == Ok(1) =>
             {
                 self.adjusting = 2;

@@ -2,7 +2,7 @@
 //! choice to the implementation (4.3 fixes maxima of acceleration and deceleration, not a
 //! profile; chapter 3 fixes no reaction time), as a second team's drive would behave.
 
-use crate::spec;
+use crate::{psd4xx_bit, spec};
 use drivespec_cyclic::{CyclicDevice, Env};
 use drivespec_positioner::Micros;
 use drivespec_psd4xx::model::{Drive, DriveConfig, RecordAnswer, RecordFailure, RecordRequest};
@@ -189,7 +189,7 @@ fn per_device(number: u16) -> bool {
 }
 
 fn reached_bit() -> u16 {
-    bit("status", "Target position reached")
+    psd4xx_bit("status", "Target position reached")
 }
 
 impl Variant {
@@ -252,14 +252,7 @@ impl Variant {
 }
 
 fn running_bit() -> u16 {
-    bit("status", "Drive is running")
-}
-
-/// The mask of the built-in spec's bit `name` of `field` (callers name bits of the spec's
-/// PSD4xx status and control words).
-fn bit(field: &str, name: &str) -> u16 {
-    let b = spec().family(FamilyId::Psd4xx).bitfield(field).unwrap();
-    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
+    psd4xx_bit("status", "Drive is running")
 }
 
 impl CyclicDevice<'static> for Variant {
@@ -280,7 +273,7 @@ impl CyclicDevice<'static> for Variant {
             }
             (out.control, out.target) = self.applied;
         }
-        let release = bit("control", "Release");
+        let release = psd4xx_bit("control", "Release");
         let sent = out.control;
         if self.restart == 2 {
             out.control &= !release;
@@ -289,14 +282,14 @@ impl CyclicDevice<'static> for Variant {
         let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
         let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
         if self.kind == Kind::DeferredRun {
-            let missing = bit("status", "Motor voltage was missing");
+            let missing = psd4xx_bit("status", "Motor voltage was missing");
             let command = sent != self.last.0 && sent & release != 0;
             if sent & release == 0 || input.status & running_bit() != 0 {
                 self.refused = false;
             } else if command && input.status & missing != 0 && self.last.1 & missing == 0 {
                 self.refused = true;
             } else if self.refused
-                && input.status & bit("status", "Power supply to motor available") != 0
+                && input.status & psd4xx_bit("status", "Power supply to motor available") != 0
             {
                 self.refused = false;
                 self.restart = 2;

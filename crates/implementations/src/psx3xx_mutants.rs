@@ -2,7 +2,7 @@
 //! `psx3xx::model::Drive`, served over the cyclic protocol in-process), shared by the mutation
 //! test (`psx3xx_mutants.rs`) and the fuzzer test (`crates/fuzz/tests/fuzz_psx3xx.rs`).
 
-use crate::spec;
+use crate::{mask, spec};
 use drivespec_cyclic::{CyclicDevice, Env, Reply};
 use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::{Request, Target, Value};
@@ -116,13 +116,11 @@ pub struct Mutant<'s> {
 }
 
 fn control_bit(drive: &Drive<'_>, name: &str) -> u16 {
-    let b = drive.rules().bitfield("control").unwrap();
-    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
+    mask(drive.rules().bitfield("control"), name)
 }
 
 fn status_bit(drive: &Drive<'_>, name: &str) -> u16 {
-    let b = drive.rules().status_bits().unwrap();
-    1 << b.bits.iter().find(|x| x.name == name).unwrap().bit
+    mask(drive.rules().status_bits(), name)
 }
 
 fn int(drive: &Drive<'_>, id: &str) -> i64 {

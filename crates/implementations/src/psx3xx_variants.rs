@@ -3,7 +3,7 @@
 //! values as examples and lets a save take up to 2000 ms), as a second team's drive would
 //! behave.
 
-use crate::spec;
+use crate::{mask, spec};
 use drivespec_cyclic::{CyclicDevice, Env, Reply};
 use drivespec_positioner::Micros;
 use drivespec_psx3xx::isdu::Request;
@@ -185,8 +185,7 @@ const DISPLACED: &str = "Manual displacement";
 
 /// The mask of the status bit `name` (3.4).
 fn status_bit(drive: &Drive<'_>, name: &str) -> u16 {
-    let bits = drive.rules().status_bits().unwrap();
-    1 << bits.bits.iter().find(|x| x.name == name).unwrap().bit
+    mask(drive.rules().status_bits(), name)
 }
 
 impl Variant<'_> {
