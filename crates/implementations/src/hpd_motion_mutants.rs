@@ -79,8 +79,8 @@ fn addr(id: &str) -> u8 {
         .family(FamilyId::Hpd)
         .parameter(id)
         .and_then(|p| p.address)
-        .unwrap();
-    u8::try_from(a).unwrap()
+        .expect("a parameter of the built-in table with a serial address");
+    u8::try_from(a).expect("serial addresses are bytes (manual 4.1)")
 }
 
 impl MotionMutant {
@@ -96,9 +96,11 @@ impl MotionMutant {
             ramp_percent,
         });
         MotionMutant {
-            inner: Drive::new(spec(), config).unwrap(),
+            inner: Drive::new(spec(), config)
+                .expect("the built-in spec builds the reference drive"),
             kind,
-            rules: FrameRules::from_spec(spec()).unwrap(),
+            rules: FrameRules::from_spec(spec())
+                .expect("the built-in spec has the HPD frame rules"),
             testing: false,
             plc_read: false,
         }
@@ -120,7 +122,8 @@ impl MotionMutant {
         else {
             return false;
         };
-        let byte = addr("Pb70") + u8::try_from(bit / 8).unwrap();
+        let byte =
+            addr("Pb70") + u8::try_from(bit / 8).expect("callers name bits of the 16-bit Pb70");
         let m = 1u8 << (bit % 8);
         par == byte && mask & m == 0 && value & m != 0
     }
@@ -287,7 +290,7 @@ impl MotionMutant {
         match new.and_then(|v| Data::from_value(v, data.len())) {
             Some(data) => Message::Response { addr: a, par, data }
                 .to_bytes(&self.rules)
-                .unwrap(),
+                .expect("a message of the spec's frame rules encodes"),
             None => bytes,
         }
     }

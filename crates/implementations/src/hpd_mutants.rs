@@ -11,7 +11,7 @@ use drivespec_sim::SimDevice;
 use drivespec_spec::{FamilyId, Readings};
 
 fn rules() -> FrameRules {
-    FrameRules::from_spec(spec()).unwrap()
+    FrameRules::from_spec(spec()).expect("the built-in spec has the HPD frame rules")
 }
 
 /// The planted deviations.
@@ -96,10 +96,10 @@ impl Mutant {
         if let Kind::Reading(option, reading) = kind {
             readings
                 .choose(spec().family(FamilyId::Hpd), option, reading)
-                .unwrap();
+                .expect("an option and reading of the built-in errata");
         }
-        let inner =
-            Drive::new(spec(), DriveConfig::commissioned(0).with_readings(readings)).unwrap();
+        let inner = Drive::new(spec(), DriveConfig::commissioned(0).with_readings(readings))
+            .expect("the built-in spec builds the reference drive");
         Mutant {
             inner,
             kind,
@@ -200,7 +200,11 @@ impl Mutant {
                         mask,
                         value,
                     };
-                    self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                    self.inner.handle_rx(
+                        now,
+                        &m.to_bytes(&self.rules)
+                            .expect("a message of the spec's frame rules encodes"),
+                    );
                     return;
                 }
             }
@@ -238,12 +242,18 @@ impl Mutant {
                     },
                     other => other,
                 };
-                self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                self.inner.handle_rx(
+                    now,
+                    &m.to_bytes(&self.rules)
+                        .expect("a message of the spec's frame rules encodes"),
+                );
                 return;
             }
             (Kind::AnswersBroadcasts, Some(Message::Broadcast { .. })) => {
                 self.inner.handle_rx(now, bytes);
-                let ack = Message::Ack { addr: own }.to_bytes(&self.rules).unwrap();
+                let ack = Message::Ack { addr: own }
+                    .to_bytes(&self.rules)
+                    .expect("a message of the spec's frame rules encodes");
                 self.extra.push(Output::Transmit {
                     at: now,
                     bytes: ack,
@@ -296,7 +306,8 @@ impl Mutant {
             (Kind::EndNeedsZeroByte, Some(Message::WritePlc { addr, par, data }))
                 if addr == own =>
             {
-                let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec()).unwrap();
+                let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec())
+                    .expect("the built-in spec has the PLC instruction table");
                 let passed_over =
                     codec
                         .decode(data.as_slice(), usize::from(par))
@@ -309,16 +320,24 @@ impl Mutant {
                         });
                 if passed_over {
                     let mut ld = Vec::new();
-                    let program = codec.parse_listing("LD 99.13").unwrap();
+                    let program = codec
+                        .parse_listing("LD 99.13")
+                        .expect("an instruction of the built-in table");
                     for (_, i) in &program.instrs {
-                        codec.encode(i, &mut ld).unwrap();
+                        codec
+                            .encode(i, &mut ld)
+                            .expect("an instruction that parsed encodes");
                     }
                     let m = Message::WritePlc {
                         addr,
                         par,
-                        data: Data::new(&ld).unwrap(),
+                        data: Data::new(&ld).expect("one instruction fits a message"),
                     };
-                    self.inner.handle_rx(now, &m.to_bytes(&self.rules).unwrap());
+                    self.inner.handle_rx(
+                        now,
+                        &m.to_bytes(&self.rules)
+                            .expect("a message of the spec's frame rules encodes"),
+                    );
                     return;
                 }
             }
@@ -367,7 +386,8 @@ impl Mutant {
         if self.inner.value(&run).unwrap_or(0) == 0 {
             return;
         }
-        let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec()).unwrap();
+        let codec = drivespec_hpd::plc::PlcCodec::from_spec(spec())
+            .expect("the built-in spec has the PLC instruction table");
         let Ok(program) = codec.decode_program(self.inner.plc_area()) else {
             return;
         };
@@ -425,9 +445,11 @@ impl Mutant {
                 let m = Message::Response {
                     addr,
                     par,
-                    data: Data::new(&rev).unwrap(),
+                    data: Data::new(&rev)
+                        .expect("no longer than the data of the message it came from"),
                 };
-                m.to_bytes(&self.rules).unwrap()
+                m.to_bytes(&self.rules)
+                    .expect("a message of the spec's frame rules encodes")
             }
             (Kind::EnableStatusNeverSet, Message::Response { addr, par, data })
                 if spec()
@@ -443,9 +465,11 @@ impl Mutant {
                 let m = Message::Response {
                     addr,
                     par,
-                    data: Data::new(&d).unwrap(),
+                    data: Data::new(&d)
+                        .expect("no longer than the data of the message it came from"),
                 };
-                m.to_bytes(&self.rules).unwrap()
+                m.to_bytes(&self.rules)
+                    .expect("a message of the spec's frame rules encodes")
             }
             (Kind::EnabledIgnoresSoftwareEnable, Message::Response { addr, par, data })
                 if spec()
@@ -467,9 +491,11 @@ impl Mutant {
                 let m = Message::Response {
                     addr,
                     par,
-                    data: Data::new(&d).unwrap(),
+                    data: Data::new(&d)
+                        .expect("no longer than the data of the message it came from"),
                 };
-                m.to_bytes(&self.rules).unwrap()
+                m.to_bytes(&self.rules)
+                    .expect("a message of the spec's frame rules encodes")
             }
             (Kind::AckWithChecksum, Message::Ack { .. }) => {
                 let mut b = bytes.clone();
@@ -589,7 +615,7 @@ pub fn strict_readings(kind: Kind) -> Vec<(String, String)> {
         .errata
         .iter()
         .find(|e| e.option.as_deref() == Some(option))
-        .unwrap();
+        .expect("an option of the built-in errata");
     vec![(option.to_owned(), e.adopted.clone())]
 }
 

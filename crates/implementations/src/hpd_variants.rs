@@ -43,7 +43,7 @@ impl Variant {
         if let Kind::Reading(option, reading) = kind {
             readings
                 .choose(spec().family(FamilyId::Hpd), option, reading)
-                .unwrap();
+                .expect("an option and reading of the built-in errata");
         }
         let mut config = DriveConfig::commissioned(0).with_readings(readings);
         if let Kind::Motion(start_latency_us, ramp_percent) = kind {
@@ -52,7 +52,8 @@ impl Variant {
                 ramp_percent,
             });
         }
-        let mut inner = Drive::new(spec(), config).unwrap();
+        let mut inner =
+            Drive::new(spec(), config).expect("the built-in spec builds the reference drive");
         if let Kind::ScanPhase(shift) = kind {
             inner.advance(shift);
         }

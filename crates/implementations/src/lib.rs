@@ -18,9 +18,9 @@
 //!
 //! These are test fixtures, not a library for users (unpublished): they are built from the
 //! built-in spec and end with a panic when it does not load.
-//! Their `unwrap`s read names and tables of the built-in spec or re-encode messages built
-//! from frames that decoded; none depends on what a runner sends them (values a runner can
-//! set, such as parameters, are converted without `unwrap`).
+//! Each `expect` says why it cannot fail: it reads names and tables of the built-in spec or
+//! re-encodes messages built from frames that decoded; none depends on what a runner sends
+//! them (values a runner can set, such as parameters, are converted without `expect`).
 #![forbid(unsafe_code)]
 #![allow(
     missing_docs,
@@ -48,7 +48,9 @@ use std::sync::OnceLock;
 /// The built-in spec, loaded once.
 pub fn spec() -> &'static Spec {
     static SPEC: OnceLock<Spec> = OnceLock::new();
-    SPEC.get_or_init(|| Spec::builtin().unwrap())
+    SPEC.get_or_init(|| {
+        Spec::builtin().expect("the built-in spec loads (checked by `drivespec spec check`)")
+    })
 }
 
 /// HPD parameter or bit `name` (`Pr31`, `b70.7`) of the built-in spec; callers name entries

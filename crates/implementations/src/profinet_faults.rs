@@ -101,10 +101,10 @@ pub const NAMES: [&str; 1] = ["restart-on-malformed-identify"];
 
 /// The PSD4xx of `model` named `station` at `mac`/`ip` (the reference device's defaults).
 pub fn reference(spec: &Spec, model: &str, mac: [u8; 6], ip: [u8; 4], station: &str) -> Device {
-    let mut c = DeviceConfig::new(spec, model, mac, station).unwrap();
+    let mut c = DeviceConfig::new(spec, model, mac, station).expect("the spec's PROFINET identity");
     c.ip = ip;
     c.netmask = [255, 255, 255, 0];
-    Device::new(spec, c).unwrap()
+    Device::new(spec, c).expect("a model of the spec")
 }
 
 /// Longest sleep between two looks at the socket (as `drivespec sim --profinet`).

@@ -77,10 +77,10 @@ fn one_attempt() -> &'static drivespec_spec::Spec {
         let path = "psd4xx/protocol.toml";
         let text = files
             .get(path)
-            .unwrap()
+            .expect("a file of the built-in spec")
             .replace("attempts = 2", "attempts = 1");
         files.set(path, &text);
-        drivespec_spec::Spec::from_files(&files).unwrap()
+        drivespec_spec::Spec::from_files(&files).expect("the built-in spec with one attempt loads")
     })
 }
 
@@ -114,8 +114,8 @@ impl Mutant {
         } else {
             spec()
         };
-        let drive =
-            Drive::new(spec, drivespec_psd4xx::model::DriveConfig::new("PSD401-5V")).unwrap();
+        let drive = Drive::new(spec, drivespec_psd4xx::model::DriveConfig::new("PSD401-5V"))
+            .expect("the built-in spec builds the reference drive");
         Mutant {
             kind,
             drive,
@@ -145,7 +145,9 @@ impl CyclicDevice<'static> for Mutant {
             Kind::PkwRefresh if self.last_pkw == Some(out.pkw) => {
                 let mut idle = out;
                 idle.pkw = PkwRequest::default();
-                let b = idle.to_bytes(&rules).unwrap();
+                let b = idle
+                    .to_bytes(&rules)
+                    .expect("an image of the spec's layout encodes");
                 self.drive.cycle(now, &b)?;
             }
             Kind::LoopInverted => {
@@ -176,7 +178,7 @@ impl CyclicDevice<'static> for Mutant {
                         width: drivespec_psd4xx::Width::Word,
                         value: -1,
                     })
-                    .unwrap();
+                    .expect("par 96 is a writable word of the built-in table");
                 if out.pkw == minus1 {
                     out.pkw = pkw
                         .encode_request(&Request::Write {
@@ -185,12 +187,16 @@ impl CyclicDevice<'static> for Mutant {
                             width: drivespec_psd4xx::Width::Word,
                             value: -2,
                         })
-                        .unwrap();
+                        .expect("par 96 is a writable word of the built-in table");
                 }
             }
             _ => {}
         }
-        let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
+        let bytes = self.drive.cycle(
+            now,
+            &out.to_bytes(&rules)
+                .expect("an image of the spec's layout encodes"),
+        )?;
         let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
         let codes = pkw.error_codes();
         let cannot = pkw.response_codes().cannot_execute;
@@ -304,7 +310,9 @@ impl CyclicDevice<'static> for Mutant {
         if original.pkw != PkwRequest::default() {
             self.last_response = Some(input.pkw);
         }
-        Ok(input.to_bytes(&rules).unwrap())
+        Ok(input
+            .to_bytes(&rules)
+            .expect("an image of the spec's layout encodes"))
     }
 
     fn advance(&mut self, now: Micros) {
@@ -357,7 +365,7 @@ impl CyclicDevice<'static> for Mutant {
                 .family(FamilyId::Psd4xx)
                 .parameter("44")
                 .and_then(|p| p.default)
-                .unwrap();
+                .expect("par 44 has a delivery value in the built-in table");
             // Out of range after a rescaling (par 38/39): the value stays.
             let _ = self.drive.write_parameter(now, 44, delivery);
         }

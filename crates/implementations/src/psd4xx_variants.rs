@@ -159,10 +159,11 @@ impl Variant {
         if let Kind::Reading(option, reading) = kind {
             readings
                 .choose(spec().family(FamilyId::Psd4xx), option, reading)
-                .unwrap();
+                .expect("an option and reading of the built-in errata");
         }
         let config = DriveConfig::new("PSD401-5V").with_readings(readings);
-        let drive = Drive::new(spec(), config).unwrap();
+        let drive =
+            Drive::new(spec(), config).expect("the built-in spec builds the reference drive");
         Variant {
             kind,
             drive,
@@ -279,7 +280,11 @@ impl CyclicDevice<'static> for Variant {
             out.control &= !release;
         }
         self.restart = self.restart.saturating_sub(1);
-        let bytes = self.drive.cycle(now, &out.to_bytes(&rules).unwrap())?;
+        let bytes = self.drive.cycle(
+            now,
+            &out.to_bytes(&rules)
+                .expect("an image of the spec's layout encodes"),
+        )?;
         let mut input = Input::parse(&rules, &bytes).map_err(|e| e.to_string())?;
         if self.kind == Kind::DeferredRun {
             let missing = psd4xx_bit("status", "Motor voltage was missing");
@@ -305,7 +310,7 @@ impl CyclicDevice<'static> for Variant {
                     width: Width::Word,
                     value: 1,
                 })
-                .unwrap();
+                .expect("par 96 is a writable word of the built-in table");
             if out.pkw == save {
                 let since = *self.saving_since.get_or_insert(now);
                 if now.saturating_sub(since) < us {
@@ -336,7 +341,9 @@ impl CyclicDevice<'static> for Variant {
         {
             input.pkw.pwe ^= 0x0001_0005 & if input.pkw.pwe > 0xFFFF { !0 } else { 0xFFFF };
         }
-        Ok(input.to_bytes(&rules).unwrap())
+        Ok(input
+            .to_bytes(&rules)
+            .expect("an image of the spec's layout encodes"))
     }
 
     fn advance(&mut self, now: Micros) {

@@ -145,7 +145,8 @@ impl Mutant<'static> {
     pub fn new(kind: Kind) -> Mutant<'static> {
         let (model, brake) = kind.brake().unzip();
         // The default model, or the fixed model that may have the kind's brake (`Kind::brake`).
-        let reference = drivespec_sim::reference::psx3xx(spec(), model, brake).unwrap();
+        let reference = drivespec_sim::reference::psx3xx(spec(), model, brake)
+            .expect("a model and brake the built-in spec offers");
         Mutant {
             drive: reference.drive,
             kind,
@@ -358,7 +359,8 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
         if let Request::Write { data, .. } = &mut req {
             match self.kind {
                 Kind::GuardIgnored => {
-                    let guards = Guards::from_rules(&rules, &Readings::default()).unwrap();
+                    let guards = Guards::from_rules(&rules, &Readings::default())
+                        .expect("the built-in guard entries");
                     let hit = guards.guards().iter().any(|g| {
                         param.is_some_and(|p| {
                             p.id == g.guard
@@ -425,7 +427,10 @@ impl<'s> CyclicDevice<'s> for Mutant<'s> {
                 }
             }
             Kind::AcceptableVariant if name == error_name(&self.drive, |k| k.par_valoutofrng) => {
-                let above = rules.error_types().code("PAR_VALGTLIM").unwrap();
+                let above = rules
+                    .error_types()
+                    .code("PAR_VALGTLIM")
+                    .expect("an ErrorType of the built-in table");
                 Reply::IsduError(format!("0x{:04X}", above.0))
             }
             Kind::FormatSwitchImmediate

@@ -47,7 +47,8 @@ impl Variant<'static> {
     /// The variant `kind`.
     pub fn new(kind: Kind) -> Variant<'static> {
         // The default model without brake, which the built-in spec always builds.
-        let reference = drivespec_sim::reference::psx3xx(spec(), None, None).unwrap();
+        let reference = drivespec_sim::reference::psx3xx(spec(), None, None)
+            .expect("a model and brake the built-in spec offers");
         Variant::on(kind, reference.drive)
     }
 
