@@ -24,7 +24,6 @@
 #![forbid(unsafe_code)]
 #![allow(
     missing_docs,
-    clippy::unwrap_used,
     clippy::expect_used,
     clippy::indexing_slicing,
     clippy::panic
