@@ -901,6 +901,7 @@ impl Drive<'_> {
         self.timed_out = true;
         let c = self.fam.controls;
         let old = self.control;
+        let run_before = self.family_run;
         let action = if self.val(&self.fam.ids.timeout_config) == 2 {
             // PSX-TIMEOUT-005: run to ISDU 138, from standstill or during a run.
             let safe = self.val(&self.fam.ids.safe_position);
@@ -926,11 +927,19 @@ impl Drive<'_> {
         }
         self.control_changed(now, old);
         // A run that waits for the brake (5.12, 5.13) is still the run to the safe position.
-        if action == RunAction::SafePosition
-            && self.core.run_target().is_none()
-            && self.deferred.is_none()
-        {
-            self.family_run = FamilyRun::None;
+        // Where the safe position was not taken (the error bit allows only the reference
+        // loop, PSX-STS-9-BLOCK), the run in progress goes on as what it was.
+        if let FamilyRun::Safe(safe) = self.family_run {
+            let started =
+                self.core.axis().target() == Some(safe) && self.core.run_target() == Some(safe);
+            if !started && self.deferred.is_none() {
+                self.family_run = match run_before {
+                    FamilyRun::ReferenceLoop { .. } if self.core.run_target().is_some() => {
+                        run_before
+                    }
+                    _ => FamilyRun::None,
+                };
+            }
         }
     }
 
