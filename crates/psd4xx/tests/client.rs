@@ -132,6 +132,11 @@ fn run(client: &mut PkwClient, drive: &mut Drive, cycles: usize) -> Vec<(PkwResp
 }
 
 fn requests() -> impl Strategy<Value = Vec<PkwRequest>> {
+    requests_of(1..8)
+}
+
+/// Between `len.start` and `len.end - 1` commands.
+fn requests_of(len: std::ops::Range<usize>) -> impl Strategy<Value = Vec<PkwRequest>> {
     let text = prop_oneof![
         prop::sample::select(vec![1u16, 2, 3, 13, 20, 42, 44, 96, 2047])
             .prop_map(|p| format!("read:{p}")),
@@ -140,7 +145,7 @@ fn requests() -> impl Strategy<Value = Vec<PkwRequest>> {
         (-1000i64..1000).prop_map(|v| format!("write:3={v}")),
         Just("count:13".to_owned()),
     ];
-    prop::collection::vec(text, 1..8).prop_map(|v| {
+    prop::collection::vec(text, len).prop_map(|v| {
         v.iter()
             .map(|t| rules().request_from_text(t).unwrap())
             .collect()
@@ -229,8 +234,7 @@ proptest! {
     }
 
     #[test]
-    fn sticky_drive_blocks_the_next_command(reqs in requests(), latency in 0u32..4, timeout in 6u32..12) {
-        prop_assume!(reqs.len() >= 2);
+    fn sticky_drive_blocks_the_next_command(reqs in requests_of(2..8), latency in 0u32..4, timeout in 6u32..12) {
         let mut client = PkwClient::new(rules().clone(), ClientConfig { timeout_cycles: timeout, capacity: 16 });
         let mut drive = Drive::new(Mode::Sticky, latency);
         for r in &reqs {

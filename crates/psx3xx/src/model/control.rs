@@ -547,6 +547,12 @@ impl Drive<'_> {
         });
         self.core.command(now, cmd);
         self.last_cmd = cmd;
+        // A refused manual run (the error bit allows only the reference loop,
+        // PSX-STS-9-BLOCK) leaves the run in progress what it was.
+        if self.core.run_kind() != Some(RunKind::Manual) {
+            self.after_core(now);
+            return;
+        }
         self.family_run = FamilyRun::Continuous(dir);
         self.event(
             now,
