@@ -11,6 +11,20 @@
 use drivespec_positioner::profile::{approach, approach_speed, brake, rps, Kinematics, Ramps};
 use proptest::prelude::*;
 
+/// Seconds within which an approach from speed `v0` to `goal` arrives, twice over: braking
+/// from `v0`, the trapezoid over the farthest distance, and the harmonious end, whose speed
+/// falls with the distance left (time constant vmax / decel · √(blend / 2)) down to the creep
+/// speed of one step's deceleration.
+fn time_bound(r: &Ramps, v0: f64, goal: f64, dt: f64) -> f64 {
+    let brake = v0.abs() / r.decel;
+    let distance = goal.abs() + v0 * v0 / (2.0 * r.decel);
+    let travel = distance / r.vmax + r.vmax / r.accel + r.vmax / r.decel;
+    let tau = r.vmax / r.decel * (r.blend / 2.0).sqrt();
+    let creep = r.decel * dt;
+    let end = tau * ((distance / (tau * creep)).max(1.0).ln() + 2.0);
+    2.0 * (brake + travel + end) + 1.0
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -26,7 +40,8 @@ proptest! {
         let dt = 0.001;
         let mut k = Kinematics { pos: 0.0, vel: v0 * r.vmax };
         let mut arrived = false;
-        for _ in 0..2_000_000 {
+        let steps = (time_bound(&r, k.vel, goal, dt) / dt).ceil() as u64;
+        for _ in 0..steps {
             let s = approach(k, goal, &r, dt);
             let dv = s.kin.vel - k.vel;
             let speeding_up = s.kin.vel.abs() > k.vel.abs() && s.kin.vel * k.vel >= 0.0;
