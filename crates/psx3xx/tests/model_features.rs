@@ -430,6 +430,49 @@ fn psx_ctl_7_1_initial_reference_loop_clears_error_bits() {
     assert!(s.bit(0));
 }
 
+/// PSX-STS-9-BLOCK: with the error bit set, a connection time-out's run to the safe position
+/// (PSX-TIMEOUT-005) is refused and the reference loop in progress ends as the loop: bit 9
+/// reset (PSX-STS-9-RESET-1), bit 0 set for the transferred target (PSX-STS-0-SET-2).
+#[test]
+fn psx_sts_9_block_a_time_out_during_the_reference_loop_leaves_the_loop_running() {
+    let mut s = Sim::new("PSE312-8");
+    s.f1(0x14, 60000);
+    s.settle(60_000);
+    s.write_ok(137, 2);
+    s.write_ok(138, 30000);
+    s.write_ok(118, 300);
+    s.env(EnvChange::PositionFault);
+    s.f1(0x94, 60000);
+    assert_eq!(s.run(), "reference-loop");
+    s.run_ms(100);
+    s.link(LinkEvent::Lost);
+    s.run_ms(400);
+    assert_eq!(s.run(), "reference-loop");
+    s.settle(30_000);
+    assert_eq!(s.actual(), 60000);
+    assert!(!s.bit(9) && s.bit(0));
+    assert_eq!(s.drive.core().axis().target(), Some(60000));
+}
+
+/// PSX-STS-9-BLOCK: a jog key held during the reference loop with the link down (5.10) asks
+/// for a continuous run that the error bit refuses; the loop ends as the loop, and no jog
+/// follows while the key stays held.
+#[test]
+fn psx_sts_9_block_a_jog_key_during_the_reference_loop_leaves_the_loop_running() {
+    let mut s = Sim::new("PSE312-8");
+    s.f1(0x14, 60000);
+    s.settle(60_000);
+    s.env(EnvChange::PositionFault);
+    s.f1(0x94, 60000);
+    s.link(LinkEvent::Lost);
+    s.keys(JogKeys::FORWARD);
+    s.run_ms(2000);
+    assert_eq!(s.run(), "reference-loop");
+    s.settle(30_000);
+    assert_eq!(s.actual(), 60000);
+    assert!(!s.bit(9) && s.bit(0));
+}
+
 // ------------------------------------------------------------------ reference run (5.14)
 
 #[test]
