@@ -86,7 +86,7 @@ fn toward(v: f64, target: f64, max_step: f64) -> f64 {
 pub fn approach(k: Kinematics, goal: f64, r: &Ramps, dt: f64) -> Step {
     let creep = r.decel * dt;
     let s = goal - k.pos;
-    if s.abs() <= f64::EPSILON * goal.abs().max(1.0) && k.vel.abs() <= creep {
+    if s.abs() <= f64::EPSILON * goal.abs().max(1.0) && k.vel.abs() <= creep * (1.0 + 1e-9) {
         return Step {
             kin: Kinematics {
                 pos: goal,
@@ -121,12 +121,16 @@ pub fn approach(k: Kinematics, goal: f64, r: &Ramps, dt: f64) -> Step {
     let pos = k.pos + (v + new_v) / 2.0 * dt;
     let left = (goal - pos) * dir;
     if dir != 0.0 && left <= 0.0 && new_v.abs() <= creep * (1.0 + 1e-9) {
+        // On the goal at creep speed: a stop within one step's deceleration ends the run;
+        // from faster, the drive holds the goal for one step at the slower speed first, so
+        // that neither the position nor the deceleration overshoots (PSD-VEL-002).
+        let stops = v.abs() <= creep * (1.0 + 1e-9);
         return Step {
             kin: Kinematics {
                 pos: goal,
-                vel: 0.0,
+                vel: if stops { 0.0 } else { new_v },
             },
-            arrived: true,
+            arrived: stops,
         };
     }
     Step {
