@@ -39,7 +39,7 @@ fn bound(kind: Kind) -> u64 {
 /// Whether the fuzzer hunts `kind`: user flags kept over a power cycle show only when flags
 /// set, then a power cycle, then a read of Pb91 come in that order, which the suite's
 /// `hpd/cmd/power-up/Pb91` does and the fuzzer's HPD sequences (no power cycle) never do.
-/// Pr35 beyond the peak shows only while the shaft turns and a Pr66 write stops only a running
+/// Pr35 beyond the peak or the current limit shows only while the shaft turns and a Pr66 write stops only a running
 /// mode-9 profile, which need a mode set up and the motor started (the suite's `hpd/motion`
 /// cases, which are no fuzzer seeds); b41.5 and b41.12 differ only when the hardware enable
 /// input is applied and Pb41 read a scan later (`hpd/bit/b41.5/…`, `hpd/bit/b41.12/…`), a
@@ -51,6 +51,7 @@ fn hunted(kind: Kind) -> bool {
         kind,
         Kind::KeepsVolatileFlags
             | Kind::TorqueBeyondPeak
+            | Kind::TorqueBeyondLimit
             | Kind::ReservedWriteStopsProfile
             | Kind::EnableStatusNeverSet
             | Kind::EnabledIgnoresSoftwareEnable

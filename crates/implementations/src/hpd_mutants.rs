@@ -50,6 +50,9 @@ pub enum Kind {
     /// Pr35 shows the torque request before the current limit: 150.0 % of peak while the
     /// shaft turns.
     TorqueBeyondPeak,
+    /// Pr35 shows the torque request before the current limit Pr19: 95.0 % of peak while the
+    /// shaft turns, within the peak but above a limit of 90.0 %.
+    TorqueBeyondLimit,
     /// b41.5 (hardware enable status) always reads 0.
     EnableStatusNeverSet,
     /// b41.12 (drive enabled) shows the hardware enable alone, whatever b40.9.
@@ -72,6 +75,9 @@ const SERVO_SLOT_US: Micros = 49_152;
 
 /// What `TorqueBeyondPeak` shows in Pr35 while the shaft turns: 150.0 % of peak.
 const UNLIMITED_TORQUE: i64 = 1500;
+
+/// What `TorqueBeyondLimit` shows in Pr35 while the shaft turns: 95.0 % of peak.
+const UNLIMITED_CURRENT: i64 = 950;
 
 /// A drive with a deviation.
 #[derive(Clone)]
@@ -544,13 +550,18 @@ impl SimDevice for Mutant {
                 }
             }
         }
-        if self.kind == Kind::TorqueBeyondPeak {
+        let shown = match self.kind {
+            Kind::TorqueBeyondPeak => Some(UNLIMITED_TORQUE),
+            Kind::TorqueBeyondLimit => Some(UNLIMITED_CURRENT),
+            _ => None,
+        };
+        if let Some(shown) = shown {
             let speed = hpd_target("Pr0");
             let torque = hpd_target("Pr35");
             let turning = self.inner.value(&speed).unwrap_or(0) != 0;
             let _ = self
                 .inner
-                .set_value(now, &torque, if turning { UNLIMITED_TORQUE } else { 0 });
+                .set_value(now, &torque, if turning { shown } else { 0 });
         }
         if self.kind == Kind::FastTimer {
             let after = self.inner.value(&timer).unwrap_or(0);
@@ -785,7 +796,16 @@ pub fn mutants() -> Vec<Case> {
         Case {
             name: "Pr35 beyond the peak while turning",
             kind: Kind::TorqueBeyondPeak,
-            breaks: v(&["HPD-PAR-048"]),
+            breaks: v(&["HPD-PAR-048", "HPD-PAR-033"]),
+            must_fail: &[
+                "hpd/motion/mode-8/jog-forward",
+                "hpd/motion/mode-8/jog-reverse",
+            ],
+        },
+        Case {
+            name: "Pr35 beyond the current limit Pr19 while turning",
+            kind: Kind::TorqueBeyondLimit,
+            breaks: v(&["HPD-PAR-033"]),
             must_fail: &[
                 "hpd/motion/mode-8/jog-forward",
                 "hpd/motion/mode-8/jog-reverse",

@@ -63,6 +63,9 @@ const ORIENT_RPM: i64 = 200;
 /// Pr35 is in % of the drive's peak (manual 3.3): the torque a drive delivers is at most its
 /// peak, 100 % either way.
 const PEAK_PERCENT: f64 = 100.0;
+/// The current limit Pr19 of the jog cases (% of the drive's peak, manual 3.3): below the
+/// peak, and more than an unloaded shaft jogging on the ramps needs.
+const CURRENT_LIMIT_PERCENT: f64 = 90.0;
 /// Positioning profile: Pr51 (ms per 1000 rpm), Pr52 (rpm), revolutions.
 const PROFILE: (i64, i64, i64) = (200, 600, 5);
 /// Mode-8 test profile: the highest Pr51 (rpm) the case uses, one revolution a second.
@@ -126,6 +129,10 @@ struct Motion {
     torque: Probe,
     /// Pr35's raw value at the drive's peak torque.
     peak: i64,
+    /// Pr35's raw value at [`CURRENT_LIMIT_PERCENT`].
+    limit: i64,
+    /// Pr19's raw value at [`CURRENT_LIMIT_PERCENT`].
+    limit_setting: i64,
     slots: Vec<(u8, Slot)>,
     bit_lag_us: u64,
     /// The drive's slow operating-mode slot (µs): a drive may change its speed and position
@@ -145,7 +152,7 @@ impl Motion {
             })
         };
         let slots = [
-            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 28, 50, 51, 52, 53, 54, 56, 57, 64, 66,
+            5, 7, 8, 9, 10, 11, 12, 13, 14, 15, 19, 28, 50, 51, 52, 53, 54, 56, 57, 64, 66,
         ]
         .iter()
         .map(|n| Some((*n, g.slot_of(&format!("Pr{n}"))?)))
@@ -173,7 +180,12 @@ impl Motion {
             flags41: probe("Pb41", None)?,
             flags70: probe("Pb70", None)?,
             torque: probe(names::TORQUE_MONITOR, None)?,
-            peak: peak_raw(g.param(names::TORQUE_MONITOR)?.scale?),
+            peak: percent_raw(PEAK_PERCENT, g.param(names::TORQUE_MONITOR)?.scale?),
+            limit: percent_raw(
+                CURRENT_LIMIT_PERCENT,
+                g.param(names::TORQUE_MONITOR)?.scale?,
+            ),
+            limit_setting: percent_raw(CURRENT_LIMIT_PERCENT, g.param(names::PEAK_CURRENT)?.scale?),
             slots,
             bit_lag_us: u64::from(lag.period_us) + BIT_LAG_SLACK_US,
             slot_us: u64::from(slot.period_us),
@@ -205,9 +217,9 @@ impl Motion {
     }
 }
 
-/// The raw value of [`PEAK_PERCENT`] in steps of `scale` %.
-fn peak_raw(scale: f64) -> i64 {
-    let steps = (PEAK_PERCENT / scale).round();
+/// The raw value of `percent` in steps of `scale` %.
+fn percent_raw(percent: f64, scale: f64) -> i64 {
+    let steps = (percent / scale).round();
     if steps.is_finite() && steps.abs() < 1e15 {
         steps as i64
     } else {
@@ -359,7 +371,8 @@ fn pb40_with(g: &Gen, m: &Motion, bits: &[&str]) -> i64 {
 }
 
 /// HPD-MODE-8-001: jog with b70.1 (forward) or b70.2 (reverse) at Pr50, on the Pr8..Pr11
-/// ramps, then back to standstill; HPD-PAR-048: Pr35 within ± the peak while it turns.
+/// ramps, then back to standstill; HPD-PAR-048: Pr35 within ± the peak while it turns;
+/// HPD-PAR-033: and within ± the current limit Pr19.
 fn jog(g: &mut Gen, m: &Motion, forward: bool) {
     let (name, jog_bit, up, down) = if forward {
         ("forward", "b70.1", m.pr(8), m.pr(9))
@@ -378,7 +391,7 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
     let mut cb = CaseB::new(
         format!("hpd/motion/mode-8/jog-{name}"),
         format!(
-            "mode 8 with b40.2 = 1: {jog_bit} turns the shaft {name} at Pr50 = {JOG_RPM} rpm on the ramps, and back to 0 rpm when cleared; b41.0–b41.3 follow the speed; Pr35 stays within the drive's peak while it turns"
+            "mode 8 with b40.2 = 1: {jog_bit} turns the shaft {name} at Pr50 = {JOG_RPM} rpm on the ramps, and back to 0 rpm when cleared; b41.0–b41.3 follow the speed; Pr35 stays within the drive's peak and the current limit Pr19 = {CURRENT_LIMIT_PERCENT} % while it turns"
         ),
         &[],
     );
@@ -389,6 +402,7 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
         (m.pr(13), OVERSPEED, "Pr13"),
         (m.pr(14), WINDOW.0, "Pr14"),
         (m.pr(15), WINDOW.1, "Pr15"),
+        (m.pr(19), m.limit_setting, "Pr19"),
     ];
     setup(g, &mut cb, m, 8, &values);
     let pb40 = pb40_with(g, m, &[names::RESERVED_REFERENCE, names::ABSOLUTE_WINDOW]);
@@ -461,12 +475,20 @@ fn jog(g: &mut Gen, m: &Motion, forward: bool) {
         vec![m.speed, m.torque],
         HOLD_US,
         Vec::new(),
-        vec![check(
-            "HPD-PAR-048",
-            Envelope::Bounded {
-                within: within(1, -m.peak, m.peak),
-            },
-        )],
+        vec![
+            check(
+                "HPD-PAR-048",
+                Envelope::Bounded {
+                    within: within(1, -m.peak, m.peak),
+                },
+            ),
+            check(
+                "HPD-PAR-033",
+                Envelope::Bounded {
+                    within: within(1, -m.limit, m.limit),
+                },
+            ),
+        ],
     );
     g.bit(&mut cb, Role::Check, &bit, false);
     let mut checks = vec![

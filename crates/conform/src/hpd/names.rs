@@ -28,6 +28,8 @@ pub const READ_ONLY: &str = "Pr25";
 pub const WITH_DEFAULT: &str = "Pr2";
 /// The torque monitor, in % of the drive's peak (manual 3.3 Pr35).
 pub const TORQUE_MONITOR: &str = "Pr35";
+/// The current limit, in % of the drive's peak (manual 3.3 Pr19).
+pub const PEAK_CURRENT: &str = "Pr19";
 /// The hardware enable status bit (manual 3.3 b41.5).
 pub const HARDWARE_ENABLE: &str = "b41.5";
 /// The drive enabled bit (manual 3.3 b41.12).
