@@ -18,6 +18,11 @@ use std::time::Duration;
 const STDERR_KEEP: usize = 4096;
 /// Output chunks (of up to 512 bytes each) read ahead of the session.
 const CHUNKS_QUEUED: usize = 256;
+/// How long a process that closed its output is given to exit, and its stderr to reach its
+/// end, before the evidence is taken (a process holding stderr open is not waited for longer).
+const EXIT_GRACE: Duration = Duration::from_millis(500);
+/// Steps in which an exit within [`EXIT_GRACE`] is looked for.
+const EXIT_POLL: Duration = Duration::from_millis(10);
 
 /// A running subprocess and the threads that move its bytes.
 struct Proc {
@@ -25,6 +30,8 @@ struct Proc {
     to_child: Sender<Vec<u8>>,
     from_child: Receiver<(Micros, Vec<u8>)>,
     stderr: Arc<Mutex<Vec<u8>>>,
+    /// Disconnected once the stderr reader has read to the end.
+    stderr_done: Receiver<()>,
 }
 
 /// A subprocess speaking the protocol on stdin/stdout.
@@ -63,7 +70,14 @@ impl ExecLink {
     fn ended(&mut self) -> LinkError {
         let detail = match self.proc.take() {
             Some(mut p) => {
-                let status = match p.child.try_wait() {
+                let mut exited = p.child.try_wait();
+                let mut waited = Duration::ZERO;
+                while matches!(exited, Ok(None)) && waited < EXIT_GRACE {
+                    std::thread::sleep(EXIT_POLL);
+                    waited += EXIT_POLL;
+                    exited = p.child.try_wait();
+                }
+                let status = match exited {
                     Ok(Some(s)) => format!("; the process exited ({s})"),
                     _ => {
                         let _ = p.child.kill();
@@ -71,6 +85,9 @@ impl ExecLink {
                         "; the process closed its output and was killed".to_owned()
                     }
                 };
+                // The reader may not have taken the last lines the process wrote before it
+                // ended (Err: it has read to the end, or the grace is over).
+                let _ = p.stderr_done.recv_timeout(EXIT_GRACE);
                 let tail = p
                     .stderr
                     .lock()
@@ -145,7 +162,9 @@ fn start(argv: &[String], clock: WallClock) -> Result<Proc, LinkError> {
     });
     let keep = Arc::new(Mutex::new(Vec::new()));
     let sink = Arc::clone(&keep);
+    let (done, stderr_done) = mpsc::channel::<()>();
     std::thread::spawn(move || {
+        let _done = done;
         let mut stderr = stderr;
         let mut buf = [0u8; 512];
         while let Ok(n) = stderr.read(&mut buf) {
@@ -164,6 +183,7 @@ fn start(argv: &[String], clock: WallClock) -> Result<Proc, LinkError> {
         to_child,
         from_child,
         stderr: keep,
+        stderr_done,
     })
 }
 
